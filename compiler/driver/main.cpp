@@ -1,0 +1,2 @@
+// qdot command line (being written).
+int main() { return 0; }

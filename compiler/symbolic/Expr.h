@@ -1,0 +1,164 @@
+// The symbolic expression DAG used by every stage from flatten on.
+//
+// Nodes are immutable and hash-consed inside a Context: structurally equal expressions are the same
+// node, so equality is pointer equality and `Expr` is a plain pointer. Constructors simplify to a
+// canonical form as they build:
+//   * Add:  constant + Σ coef_i * term_i. Terms are non-constant, not Add, not a Mul with a
+//           numeric coefficient (that coefficient moves into coef_i), sorted by a stable order,
+//           like terms collected, zero coefficients dropped. No Add with one term of coef 1 and
+//           constant 0 survives (it is that term).
+//   * Mul:  coef * Π base_i ^ exp_i. Bases are non-constant and not Mul; equal bases have their
+//           exponents added; exponent-0 factors dropped; coef 0 gives 0. A Mul of a single factor
+//           with coef 1 is that factor (or a Pow). Products of sums are NOT expanded; a numeric
+//           coefficient times an Add is kept as a Mul (no distribution), so sizes stay linear.
+//   * Pow:  base ^ exponent with both folded when constant; x^0 = 1, x^1 = x, (x^a)^b = x^(a*b)
+//           for integer b.
+//   * functions fold on constant arguments (sin(0) = 0, exp(0) = 1, ...); x - x = 0, x / x = 1.
+// Subtraction a - b is a + (-1)*b; division a / b is a * b^-1; sqrt(x) is x^0.5.
+//
+// Costs the later stages rely on: building a node is O(arity) amortised (O(n log n) for an n-ary
+// Add/Mul); diff(e, s) is memoised per (node, symbol) and returns zero in O(1) for a node whose
+// symbol mask shows it cannot contain s, so differentiating a sum of N terms is O(N) and repeated
+// derivatives share nodes.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+namespace qdot::sym {
+
+enum class Kind : uint8_t {
+#define QDOT_EXPR_KIND(K, A, S) K,
+#include "symbolic/ExprKinds.def"
+};
+
+/// Printable name of a kind ("sin", "+", ...).
+const char* kindSpelling(Kind k);
+
+struct Node;
+using Expr = const Node*;
+
+/// One immutable node. Fields used depend on the kind:
+///  Constant: value.     Symbol: symbolId (dense, 0-based, in creation order).
+///  Add: value = constant term; args = terms; coefs = their numeric coefficients.
+///  Mul: value = numeric coefficient; args = bases, exps = exponents (Exprs, often constants).
+///  every other kind: args in order (Select: cond, then, else).
+struct Node {
+  Kind kind;
+  uint32_t symbolId = 0;
+  uint64_t hash = 0;
+  uint64_t symbolMask = 0;  ///< bit (id % 64) set for every symbol below; 0 => constant expression
+  uint32_t depth = 0;       ///< longest path to a leaf (leaves 0)
+  double value = 0;
+  std::vector<Expr> args;
+  std::vector<double> coefs;  ///< Add only
+  std::vector<Expr> exps;     ///< Mul only
+
+  bool isConstant() const { return kind == Kind::Constant; }
+  bool isSymbol() const { return kind == Kind::Symbol; }
+  bool isZero() const { return kind == Kind::Constant && value == 0.0; }
+  bool isOne() const { return kind == Kind::Constant && value == 1.0; }
+};
+
+/// Owns every node, interns them, and remembers symbol names and derivative memos.
+/// Not thread-safe. Nodes live as long as the Context.
+class Context {
+ public:
+  Context();
+  ~Context();
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+  // --- leaves -----------------------------------------------------------------------------
+  Expr constant(double v);
+  Expr zero() const { return zero_; }
+  Expr one() const { return one_; }
+  /// A new symbol, or the existing one with this name (names are unique per Context).
+  Expr symbol(std::string_view name);
+  /// Lookup without creating; nullptr if none.
+  Expr findSymbol(std::string_view name) const;
+  const std::string& symbolName(Expr s) const;
+  size_t symbolCount() const;
+
+  // --- arithmetic (all simplify to canonical form) -----------------------------------------
+  Expr add(Expr a, Expr b);
+  Expr add(std::span<const Expr> terms);
+  Expr sub(Expr a, Expr b);
+  Expr neg(Expr a);
+  Expr mul(Expr a, Expr b);
+  Expr mul(std::span<const Expr> factors);
+  Expr div(Expr a, Expr b);
+  Expr pow(Expr base, Expr exponent);
+  Expr scale(double c, Expr a);  ///< c * a
+
+  // --- functions ---------------------------------------------------------------------------
+  /// Any unary function kind (Sin … Sign, Not). sqrt is pow(x, 0.5); log10(x) is log(x)/log(10).
+  Expr unary(Kind k, Expr x);
+  /// Atan2, Min, Max, Lt, Le, Eq, Ne, And, Or. (a > b is Lt(b, a); a >= b is Le(b, a).)
+  Expr binary(Kind k, Expr a, Expr b);
+  Expr select(Expr cond, Expr ifTrue, Expr ifFalse);
+
+  // --- calculus and rewriting ---------------------------------------------------------------
+  /// ∂e/∂s for a symbol s. Memoised; derivative rules for every kind live in Derivative.cpp.
+  /// abs, sign, min, max, comparisons and select differentiate piecewise (sign(x)*x' etc.).
+  Expr diff(Expr e, Expr s);
+  /// Replaces symbols by expressions (all at once, not recursively) and re-simplifies.
+  Expr substitute(Expr e, const std::unordered_map<Expr, Expr>& map);
+
+  /// True if symbol s occurs in e (exact; uses the mask to answer "no" fast).
+  bool dependsOn(Expr e, Expr s) const;
+  /// The distinct symbols in e, in order of first occurrence (depth-first, left to right).
+  std::vector<Expr> freeSymbols(Expr e) const;
+  /// Number of distinct nodes reachable from the roots (the DAG size).
+  size_t dagSize(std::span<const Expr> roots) const;
+
+  size_t nodeCount() const;
+
+  // Implementation detail (Context.cpp); public only so the rule files can reach it.
+  struct Impl;
+  Impl& impl() { return *impl_; }
+
+ private:
+  std::unique_ptr<Impl> impl_;
+  Expr zero_, one_;
+};
+
+// --- evaluation --------------------------------------------------------------------------------
+
+/// Evaluates e with symbol values indexed by symbolId (values.size() >= symbolCount()).
+/// Booleans are 1.0/0.0. Follows IEEE semantics (sqrt(-1) = NaN, log(0) = -inf).
+double evaluate(Expr e, std::span<const double> values);
+
+/// Evaluates many roots sharing one memo (each node computed once).
+void evaluate(std::span<const Expr> roots, std::span<const double> values, std::span<double> out);
+
+// --- printing ----------------------------------------------------------------------------------
+
+/// Infix text with minimal parentheses, Modelica-like: `rho*A*l*der(v) + 2*rho*A*g*x`,
+/// `x^2`, `-(a*b)`, `sin(th[1])`, `if c then a else b`, comparisons as `<`, `<=`, `==`, `<>`.
+/// Numbers in shortest round-trip form. Terms of a sum print with a leading minus as ` - `.
+std::string toString(const Context& ctx, Expr e);
+
+// --- common-subexpression elimination ----------------------------------------------------------
+
+/// The result of CSE over a set of outputs: temporaries in evaluation order (each value uses only
+/// symbols, earlier temporaries and constants) and the outputs rewritten in terms of them.
+struct CseResult {
+  std::vector<std::pair<Expr, Expr>> temporaries;  ///< (temporary symbol, value)
+  std::vector<Expr> outputs;
+};
+
+/// A node becomes a temporary when it is non-leaf and used more than once across all outputs.
+/// Temporary symbols are named `<prefix>0`, `<prefix>1`, ... in the same Context.
+CseResult eliminateCommonSubexpressions(Context& ctx, std::span<const Expr> outputs,
+                                        std::string_view prefix = "_t");
+
+}  // namespace qdot::sym
