@@ -184,6 +184,10 @@ struct EndExpr : Expr {
   static bool classof(const Expr* e) { return e->kind == ExprKind::End; }
 };
 
+/// A deep copy of `e` (used where one written expression applies to several declarations, e.g.
+/// the `[3]` of `Real[3] x, y;`). Defined in AST.cpp.
+ExprPtr clone(const Expr& e);
+
 // ---------------------------------------------------------------------------------------------
 // Modifications: `(start = h/2, fixed = true)`, `Mass m1(m = 2)`, `experiment(StopTime = 10)`
 // ---------------------------------------------------------------------------------------------

@@ -140,6 +140,34 @@ double evaluate(Expr e, std::span<const double> values);
 /// Evaluates many roots sharing one memo (each node computed once).
 void evaluate(std::span<const Expr> roots, std::span<const double> values, std::span<double> out);
 
+/// Compiles roots once into a flat post-order tape (each distinct node one slot) so they can be
+/// evaluated repeatedly for different symbol values without re-traversing the DAG. Both branches of
+/// a select are computed (IEEE arithmetic never traps, so this is only a cost, never an error).
+class Evaluator {
+ public:
+  explicit Evaluator(std::span<const Expr> roots);
+  /// Values indexed by symbolId (must cover every symbol in the roots); out.size() >= roots.size().
+  void run(std::span<const double> values, std::span<double> out);
+  /// Number of distinct nodes on the tape.
+  size_t tapeSize() const { return nodes_.size(); }
+
+ private:
+  std::vector<Expr> nodes_;         // post-order
+  std::vector<uint32_t> argStart_;  // nodes_.size() + 1 offsets into argSlots_
+  std::vector<uint32_t> argSlots_;  // tape slots of each node's children (args then exps)
+  std::vector<uint32_t> roots_;     // tape slot of each root
+  std::vector<double> slots_;       // scratch values
+  uint32_t minValues_ = 0;          // 1 + largest symbolId used
+};
+
+// --- ordering ----------------------------------------------------------------------------------
+
+/// The deterministic structural total order used for canonical Add terms and Mul factors (and so
+/// for printing): by kind (ExprKinds.def order), then constant value / symbolId (creation order),
+/// then depth, then children lexicographically, then coefficients. Never uses pointers or hashes.
+/// Returns <0, 0 (same node), >0.
+int structuralCompare(Expr a, Expr b);
+
 // --- printing ----------------------------------------------------------------------------------
 
 /// Infix text with minimal parentheses, Modelica-like: `rho*A*l*der(v) + 2*rho*A*g*x`,

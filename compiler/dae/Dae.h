@@ -1,0 +1,87 @@
+// The DAE IR: one implicit system F(t, y, y', p) = 0 assembled from a FlatModel and its
+// equations of motion. Variables are classified (differential state or algebraic) and ordered
+// as results are written: coordinates, velocities, other states, algebraic variables, multipliers.
+// Every equation keeps its Origin. This is what structural analysis and the kernels consume.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "flatten/FlatModel.h"
+#include "mechanics/EulerLagrange.h"
+#include "support/Diagnostic.h"
+#include "symbolic/Expr.h"
+
+namespace qdot::dae {
+
+enum class VarKind { State, Algebraic };
+enum class VarRole { Coordinate, Velocity, State, Algebraic, Multiplier };
+const char* roleName(VarRole r);
+
+struct Variable {
+  std::string name;
+  VarKind kind = VarKind::Algebraic;
+  VarRole role = VarRole::Algebraic;
+  sym::Expr y = nullptr;   ///< the variable's symbol
+  sym::Expr yp = nullptr;  ///< its time-derivative symbol (states only)
+  int flatVar = -1;        ///< index in the FlatModel (-1 for multipliers)
+  SourceRange declRange;
+  sym::Expr start = nullptr;  ///< over parameters; null = no start given
+  bool fixed = false;
+  sym::Expr nominal = nullptr;
+  std::string description, unit;
+};
+
+struct Equation {
+  sym::Expr residual = nullptr;
+  flat::Origin origin;
+  sym::Expr lhs = nullptr, rhs = nullptr;  ///< as written, when it came from the model text
+};
+
+struct Parameter {
+  std::string name;
+  sym::Expr symbol = nullptr;
+  sym::Expr value = nullptr;  ///< default, over other parameters
+  std::string description, unit;
+  SourceRange declRange;
+};
+
+/// A quantity conserved along solutions (first integral) or otherwise worth monitoring.
+struct Invariant {
+  std::string name;
+  std::string kind;  ///< "cyclic momentum" or "Jacobi integral"
+  sym::Expr value = nullptr;
+};
+
+struct Dae {
+  std::string name, description;
+  SourceRange range;
+  sym::Expr time = nullptr;
+  std::vector<Variable> variables;
+  std::vector<Parameter> parameters;
+  std::vector<Equation> equations;  ///< Euler–Lagrange rows first (one per coordinate), then kinematic, user, constraints
+  std::vector<Equation> initialEquations;
+  std::vector<flat::Output> outputs;
+  std::vector<Invariant> invariants;
+  std::vector<int> coordinates;  ///< variable indices of the coordinates, in declaration order
+  flat::Experiment experiment;
+
+  size_t stateCount() const {
+    size_t n = 0;
+    for (const auto& v : variables) n += v.kind == VarKind::State;
+    return n;
+  }
+};
+
+/// Assembles the DAE, classifies variables and checks that equations and unknowns balance
+/// (naming the ones left over). Returns nullopt after reporting errors (E05xx).
+std::optional<Dae> buildDae(const flat::FlatModel& model, const mech::EquationsOfMotion& eom, sym::Context& ctx,
+                            DiagnosticEngine& diags);
+
+/// `qdot equations`: the derived system in readable mathematical form.
+void printEquations(std::ostream& os, const Dae& dae, const sym::Context& ctx, const SourceManager& sm);
+/// The same content as JSON for tools.
+void printEquationsJson(std::ostream& os, const Dae& dae, const sym::Context& ctx, const SourceManager& sm);
+
+}  // namespace qdot::dae

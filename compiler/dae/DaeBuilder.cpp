@@ -1,0 +1,145 @@
+// Assembles the DAE from the flat model and its equations of motion: classifies every unknown,
+// adds the kinematic rows q' = der(q), and checks the balance of equations and unknowns.
+#include "dae/Dae.h"
+#include "dae/Balance.h"
+
+namespace qdot::dae {
+namespace {
+
+using sym::Expr;
+
+class Builder {
+ public:
+  Builder(const flat::FlatModel& m, const mech::EquationsOfMotion& eom, sym::Context& ctx, DiagnosticEngine& diags)
+      : m_(m), eom_(eom), ctx_(ctx), diags_(diags) {}
+
+  std::optional<Dae> run() {
+    size_t errorsBefore = diags_.errorCount();
+    dae_.name = m_.name;
+    dae_.description = m_.description;
+    dae_.range = m_.range;
+    dae_.time = m_.variables[m_.byName.at("time")].symbol;
+    dae_.experiment = m_.experiment;
+    dae_.outputs = m_.outputs;
+    addParameters();
+    addMechanics();
+    addUnknowns();
+    addEquations();
+    for (const auto& fi : eom_.integrals)
+      dae_.invariants.push_back({fi.name, fi.kind == mech::FirstIntegral::Kind::Jacobi ? "Jacobi integral" : "cyclic momentum", fi.value});
+    // With constraints the system has index 3 and its structure is only checked once index
+    // reduction exists (structural issue); until then the counts must agree.
+    if (diags_.errorCount() == errorsBefore && eom_.multipliers.empty()) checkBalance(dae_, ctx_, diags_);
+    if (!eom_.multipliers.empty() && dae_.equations.size() != dae_.variables.size())
+      diags_.error(dae_.range, dae_.equations.size() < dae_.variables.size() ? "E0501" : "E0502",
+                   std::to_string(dae_.equations.size()) + " equations for " + std::to_string(dae_.variables.size()) +
+                       " unknowns");
+    if (diags_.errorCount() > errorsBefore) return std::nullopt;
+    return std::move(dae_);
+  }
+
+ private:
+  const flat::FlatModel& m_;
+  const mech::EquationsOfMotion& eom_;
+  sym::Context& ctx_;
+  DiagnosticEngine& diags_;
+  Dae dae_;
+  std::vector<Equation> kinematic_;
+
+  Variable fromFlat(int index, VarKind kind, VarRole role) {
+    const flat::Variable& f = m_.variables[index];
+    Variable v{.name = f.name, .kind = kind, .role = role, .y = f.symbol, .flatVar = index, .declRange = f.declRange,
+               .start = f.start, .fixed = f.fixed, .nominal = f.nominal, .description = f.description, .unit = f.unit};
+    return v;
+  }
+
+  void addParameters() {
+    for (const auto& f : m_.variables)
+      if (f.role == flat::VarRole::Parameter)
+        dae_.parameters.push_back({f.name, f.symbol, f.value, f.description, f.unit, f.declRange});
+  }
+
+  // Coordinates first, then velocities (spec §5). A coordinate whose row contains no velocity at
+  // all is algebraic (massless node); one with velocity only through forces or dissipation keeps q
+  // as a state and its velocity algebraic.
+  void addMechanics() {
+    std::vector<Variable> velocities;
+    for (const auto& row : eom_.rows) {
+      const flat::Variable& q = m_.variables[row.coordinate];
+      const flat::Variable& v = m_.variables[q.derivative];
+      bool rowHasVelocity = ctx_.dependsOn(row.residual, v.symbol);
+      dae_.coordinates.push_back(static_cast<int>(dae_.variables.size()));
+      if (!row.inertial && !rowHasVelocity) {
+        dae_.variables.push_back(fromFlat(row.coordinate, VarKind::Algebraic, VarRole::Coordinate));
+        continue;
+      }
+      Variable qv = fromFlat(row.coordinate, VarKind::State, VarRole::Coordinate);
+      qv.yp = ctx_.symbol("$der(" + q.name + ")");
+      kinematic_.push_back({ctx_.sub(qv.yp, v.symbol), {flat::OriginKind::Kinematic, q.declRange, row.coordinate, ""}});
+      dae_.variables.push_back(qv);
+      Variable vv = fromFlat(q.derivative, row.inertial ? VarKind::State : VarKind::Algebraic, VarRole::Velocity);
+      vv.start = v.start ? v.start : ctx_.zero();  // a velocity starts at 0 unless an initial equation says otherwise
+      if (row.inertial) vv.yp = m_.variables[v.derivative].symbol;
+      velocities.push_back(vv);
+    }
+    dae_.variables.insert(dae_.variables.end(), velocities.begin(), velocities.end());
+  }
+
+  void addUnknowns() {
+    std::vector<Variable> algebraic;
+    for (int i = 0; i < static_cast<int>(m_.variables.size()); ++i) {
+      const flat::Variable& f = m_.variables[i];
+      if (f.role != flat::VarRole::Unknown) continue;
+      if (f.derivative >= 0) {
+        Variable v = fromFlat(i, VarKind::State, VarRole::State);
+        v.yp = m_.variables[f.derivative].symbol;
+        dae_.variables.push_back(v);
+      } else {
+        algebraic.push_back(fromFlat(i, VarKind::Algebraic, VarRole::Algebraic));
+      }
+    }
+    dae_.variables.insert(dae_.variables.end(), algebraic.begin(), algebraic.end());
+    for (const auto& mult : eom_.multipliers) {
+      const auto& c = m_.constraints[mult.constraint];
+      dae_.variables.push_back({.name = mult.name, .kind = VarKind::Algebraic, .role = VarRole::Multiplier,
+                                .y = mult.symbol, .declRange = c.origin.range,
+                                .description = "Lagrange multiplier of the constraint"});
+    }
+  }
+
+  void addEquations() {
+    for (const auto& row : eom_.rows) {
+      const flat::Variable& q = m_.variables[row.coordinate];
+      dae_.equations.push_back({row.residual, {flat::OriginKind::EulerLagrange, q.declRange, row.coordinate, ""}});
+    }
+    dae_.equations.insert(dae_.equations.end(), kinematic_.begin(), kinematic_.end());
+    for (const auto& e : m_.equations) dae_.equations.push_back({e.residual, e.origin, e.lhs, e.rhs});
+    for (size_t k = 0; k < m_.constraints.size(); ++k) {
+      const auto& c = m_.constraints[k];
+      flat::Origin o = c.origin;
+      o.variable = static_cast<int>(k);
+      dae_.equations.push_back({c.residual, o, c.lhs, c.rhs});
+    }
+    for (const auto& e : m_.initialEquations) dae_.initialEquations.push_back({e.residual, e.origin, e.lhs, e.rhs});
+  }
+};
+
+}  // namespace
+
+const char* roleName(VarRole r) {
+  switch (r) {
+    case VarRole::Coordinate: return "coordinate";
+    case VarRole::Velocity: return "velocity";
+    case VarRole::State: return "state";
+    case VarRole::Algebraic: return "algebraic";
+    case VarRole::Multiplier: return "multiplier";
+  }
+  return "?";
+}
+
+std::optional<Dae> buildDae(const flat::FlatModel& model, const mech::EquationsOfMotion& eom, sym::Context& ctx,
+                            DiagnosticEngine& diags) {
+  return Builder(model, eom, ctx, diags).run();
+}
+
+}  // namespace qdot::dae

@@ -1,0 +1,130 @@
+// Printers of the derived system for `qdot equations`: readable text and JSON.
+#include <ostream>
+
+#include "dae/Dae.h"
+
+namespace qdot::dae {
+namespace {
+
+std::string where(const SourceManager& sm, SourceRange r) {
+  if (!r.valid()) return "";
+  LineCol lc = sm.lineCol(r.file, r.begin);
+  return sm.name(r.file) + ":" + std::to_string(lc.line) + ":" + std::to_string(lc.col);
+}
+
+std::string equationText(const Equation& e, const sym::Context& ctx) {
+  if (e.lhs) return sym::toString(ctx, e.lhs) + " = " + sym::toString(ctx, e.rhs);
+  return sym::toString(ctx, e.residual) + " = 0";
+}
+
+std::string joinVariables(const Dae& dae, VarKind kind) {
+  std::string s;
+  for (const auto& v : dae.variables)
+    if (v.kind == kind) s += (s.empty() ? "" : ", ") + v.name;
+  return s.empty() ? "(none)" : s;
+}
+
+void printSystemSummary(std::ostream& os, const Dae& dae) {
+  size_t states = dae.stateCount();
+  os << "system: " << dae.equations.size() << " equations, " << dae.variables.size() << " unknowns (" << states
+     << " differential, " << dae.variables.size() - states << " algebraic), " << dae.parameters.size()
+     << " parameters\n";
+}
+
+std::string jsonString(std::string_view s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\', out += c;
+    else if (c == '\n') out += "\\n";
+    else if (static_cast<unsigned char>(c) < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      out += buf;
+    } else out += c;
+  }
+  return out + "\"";
+}
+
+}  // namespace
+
+void printEquations(std::ostream& os, const Dae& dae, const sym::Context& ctx, const SourceManager& sm) {
+  os << "model " << dae.name;
+  if (!dae.description.empty()) os << " \"" << dae.description << "\"";
+  os << "\n\n";
+  if (!dae.coordinates.empty()) os << "Euler-Lagrange equations (d/dt dL/dder(q) - dL/dq + dD/dder(q) = Q):\n";
+  size_t row = 0;
+  for (int c : dae.coordinates) {
+    const Equation& e = dae.equations[row++];
+    os << "  " << dae.variables[c].name << ":  " << sym::toString(ctx, e.residual) << " = 0\n";
+    os << "      (" << where(sm, e.origin.range) << ")\n";
+  }
+  bool header = false;
+  for (const auto& e : dae.equations) {
+    if (e.origin.kind == flat::OriginKind::EulerLagrange || e.origin.kind == flat::OriginKind::Kinematic) continue;
+    if (!header) os << (dae.coordinates.empty() ? "" : "\n") << "equations:\n";
+    header = true;
+    os << "  " << equationText(e, ctx) << (e.origin.kind == flat::OriginKind::Constraint ? "   (constraint)" : "")
+       << "\n";
+  }
+  if (!dae.initialEquations.empty()) {
+    os << "\ninitial equations:\n";
+    for (const auto& e : dae.initialEquations) os << "  " << equationText(e, ctx) << "\n";
+  }
+  os << "\n";
+  printSystemSummary(os, dae);
+  os << "  states:     " << joinVariables(dae, VarKind::State) << "\n";
+  os << "  algebraic:  " << joinVariables(dae, VarKind::Algebraic) << "\n";
+  os << "  parameters: ";
+  for (size_t i = 0; i < dae.parameters.size(); ++i)
+    os << (i ? ", " : "") << dae.parameters[i].name << " = " << sym::toString(ctx, dae.parameters[i].value);
+  os << (dae.parameters.empty() ? "(none)\n" : "\n");
+  if (!dae.outputs.empty()) {
+    os << "\noutputs:\n";
+    for (const auto& o : dae.outputs) os << "  " << o.name << " = " << sym::toString(ctx, o.value) << "\n";
+  }
+  os << "\nfirst integrals:";
+  if (dae.invariants.empty()) os << " none (explicit time, dissipation or non-conservative forces)";
+  os << "\n";
+  for (const auto& inv : dae.invariants)
+    os << "  " << inv.name << " (" << inv.kind << ", conserved) = " << sym::toString(ctx, inv.value) << "\n";
+}
+
+void printEquationsJson(std::ostream& os, const Dae& dae, const sym::Context& ctx, const SourceManager& sm) {
+  auto str = [&](sym::Expr e) { return jsonString(sym::toString(ctx, e)); };
+  os << "{\n  \"model\": " << jsonString(dae.name) << ",\n  \"description\": " << jsonString(dae.description)
+     << ",\n  \"coordinates\": [";
+  for (size_t i = 0; i < dae.coordinates.size(); ++i) {
+    const Variable& q = dae.variables[dae.coordinates[i]];
+    const Equation& e = dae.equations[i];
+    os << (i ? ",\n" : "\n") << "    {\"name\": " << jsonString(q.name) << ", \"equation\": " << str(e.residual)
+       << ", \"location\": " << jsonString(where(sm, e.origin.range)) << "}";
+  }
+  os << "\n  ],\n  \"equations\": [";
+  bool first = true;
+  for (const auto& e : dae.equations) {
+    if (e.origin.kind == flat::OriginKind::EulerLagrange || e.origin.kind == flat::OriginKind::Kinematic) continue;
+    os << (first ? "\n" : ",\n") << "    {\"residual\": " << str(e.residual) << ", \"text\": "
+       << jsonString(equationText(e, ctx)) << ", \"origin\": "
+       << jsonString(e.origin.kind == flat::OriginKind::Constraint ? "constraint" : "equation")
+       << ", \"location\": " << jsonString(where(sm, e.origin.range)) << "}";
+    first = false;
+  }
+  os << "\n  ],\n  \"variables\": [";
+  for (size_t i = 0; i < dae.variables.size(); ++i) {
+    const Variable& v = dae.variables[i];
+    os << (i ? ",\n" : "\n") << "    {\"name\": " << jsonString(v.name) << ", \"kind\": "
+       << jsonString(v.kind == VarKind::State ? "state" : "algebraic") << ", \"role\": " << jsonString(roleName(v.role))
+       << (v.start ? ", \"start\": " + str(v.start) : std::string()) << "}";
+  }
+  os << "\n  ],\n  \"parameters\": [";
+  for (size_t i = 0; i < dae.parameters.size(); ++i)
+    os << (i ? ",\n" : "\n") << "    {\"name\": " << jsonString(dae.parameters[i].name)
+       << ", \"value\": " << str(dae.parameters[i].value) << "}";
+  os << "\n  ],\n  \"firstIntegrals\": [";
+  for (size_t i = 0; i < dae.invariants.size(); ++i)
+    os << (i ? ",\n" : "\n") << "    {\"name\": " << jsonString(dae.invariants[i].name) << ", \"kind\": "
+       << jsonString(dae.invariants[i].kind) << ", \"value\": " << str(dae.invariants[i].value) << "}";
+  os << "\n  ]\n}\n";
+}
+
+}  // namespace qdot::dae

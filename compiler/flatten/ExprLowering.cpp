@@ -1,0 +1,312 @@
+// Lowers AST expressions to Values (arrays of symbolic expressions): names, subscripts, operators
+// with Modelica's array rules, built-in functions, reductions, comprehensions, der().
+// Error codes E03xx (see compiler/flatten/README.md).
+#include <cmath>
+#include <numbers>
+
+#include "flatten/Flattener.h"
+
+namespace qdot::flat {
+
+using namespace qdot::ast;
+using sym::Expr;
+using sym::Kind;
+
+std::string shapeText(const std::vector<int>& shape) {
+  if (shape.empty()) return "a scalar";
+  std::string s = "[";
+  for (size_t i = 0; i < shape.size(); ++i) s += (i ? ", " : "") + std::to_string(shape[i]);
+  return s + "]";
+}
+
+void Flattener::fail(SourceRange r, std::string code, std::string msg, std::string help) {
+  diags_.error(r, std::move(code), std::move(msg), std::move(help));
+  throw FlattenAbort{};
+}
+
+Expr Flattener::lowerScalar(const ast::Expr& e, const char* what) {
+  Value v = lower(e);
+  if (!v.isScalar())
+    fail(e.range, "E0302", std::string(what) + " must be a scalar, but this is an array of shape " + shapeText(v.shape));
+  return v.elems[0];
+}
+
+double Flattener::lowerConstant(const ast::Expr& e, const char* what) {
+  Expr x = lowerScalar(e, what);
+  if (!x->isConstant())
+    fail(e.range, "E0303", std::string(what) + " must be known at compile time",
+         "use literals, constants and Integer parameters here");
+  return x->value;
+}
+
+long Flattener::lowerInteger(const ast::Expr& e, const char* what) {
+  double v = lowerConstant(e, what);
+  if (v != std::floor(v) || std::fabs(v) > 1e9)
+    fail(e.range, "E0303", std::string(what) + " must be an Integer, but it is " + sym::toString(ctx_, ctx_.constant(v)));
+  return static_cast<long>(v);
+}
+
+Value Flattener::lower(const ast::Expr& e) {
+  switch (e.kind) {
+    case ExprKind::Number: return Value::scalar(ctx_.constant(cast<NumberExpr>(&e)->value));
+    case ExprKind::Bool: return Value::scalar(cast<BoolExpr>(&e)->value ? ctx_.one() : ctx_.zero());
+    case ExprKind::Name: return lowerName(*cast<NameExpr>(&e));
+    case ExprKind::Index: return lowerIndex(*cast<IndexExpr>(&e));
+    case ExprKind::Unary: return lowerUnary(*cast<UnaryExpr>(&e));
+    case ExprKind::Binary: return lowerBinary(*cast<BinaryExpr>(&e));
+    case ExprKind::Call: return lowerCall(*cast<CallExpr>(&e));
+    case ExprKind::Range: return lowerRange(*cast<RangeExpr>(&e));
+    case ExprKind::Array: return lowerArray(*cast<ArrayExpr>(&e));
+    case ExprKind::Comprehension: return lowerComprehension(*cast<ComprehensionExpr>(&e));
+    case ExprKind::If: return lowerIf(*cast<IfExpr>(&e));
+    case ExprKind::End:
+      if (endContext_.empty()) fail(e.range, "E0304", "'end' is only allowed inside a subscript");
+      return Value::scalar(ctx_.constant(endContext_.back()->shape[endDim_.back()]));
+    case ExprKind::String: fail(e.range, "E0213", "a string is not allowed here");
+    case ExprKind::Member: fail(e.range, "E0290", "component member access is not supported yet");
+  }
+  fail(e.range, "E0399", "unsupported expression");
+}
+
+Value Flattener::lowerName(const NameExpr& n) {
+  const std::string& name = n.parts[0];
+  for (auto it = iterators_.rbegin(); it != iterators_.rend(); ++it)
+    if (it->first == name) return Value::scalar(it->second);
+  auto s = m_.symbols.find(name);
+  if (s != m_.symbols.end()) return valueOf(*s->second.decl, n.range);
+  if (name == "time") return Value::scalar(out_.variables[out_.byName.at("time")].symbol);
+  if (name == "pi") return Value::scalar(ctx_.constant(std::numbers::pi));
+  fail(n.range, "E0202", "unknown name '" + name + "'");
+}
+
+std::vector<int> Flattener::subscriptIndices(const ast::Expr& s, int dimSize) {
+  std::vector<int> idx;
+  auto* r = dyn_cast<RangeExpr>(&s);
+  if (r && !r->start && !r->stop) {  // `:`
+    for (int i = 1; i <= dimSize; ++i) idx.push_back(i);
+    return idx;
+  }
+  if (r) {
+    for (Expr v : iterationValues(s)) idx.push_back(static_cast<int>(v->value));
+  } else {
+    idx.push_back(static_cast<int>(lowerInteger(s, "a subscript")));
+  }
+  for (int i : idx)
+    if (i < 1 || i > dimSize)
+      fail(s.range, "E0301",
+           "index " + std::to_string(i) + " is out of range 1:" + std::to_string(dimSize),
+           "array indices start at 1 and end at the size of the dimension");
+  return idx;
+}
+
+Value Flattener::lowerIndex(const IndexExpr& e) {
+  Value base = lower(*e.base);
+  if (e.subscripts.size() != base.shape.size())
+    fail(e.range, "E0305",
+         std::to_string(e.subscripts.size()) + " subscript(s) given for an array of shape " + shapeText(base.shape),
+         base.shape.empty() ? "this is a scalar: remove the subscript" : "give one subscript per dimension");
+  std::vector<std::vector<int>> picks;
+  Value result;
+  endContext_.push_back(&base);
+  for (size_t d = 0; d < e.subscripts.size(); ++d) {
+    endDim_.push_back(static_cast<int>(d));
+    try {
+      picks.push_back(subscriptIndices(*e.subscripts[d], base.shape[d]));
+    } catch (FlattenAbort&) {
+      endDim_.pop_back();
+      endContext_.pop_back();
+      throw;
+    }
+    endDim_.pop_back();
+    if (dyn_cast<RangeExpr>(e.subscripts[d].get())) result.shape.push_back(static_cast<int>(picks.back().size()));
+  }
+  endContext_.pop_back();
+  // Enumerate the cartesian product of picks in row-major order.
+  std::vector<size_t> pos(picks.size(), 0);
+  while (true) {
+    size_t flat = 0;
+    for (size_t d = 0; d < picks.size(); ++d) flat = flat * base.shape[d] + (picks[d][pos[d]] - 1);
+    result.elems.push_back(base.elems[flat]);
+    size_t d = picks.size();
+    while (d > 0 && ++pos[d - 1] == picks[d - 1].size()) pos[--d] = 0;
+    if (d == 0) break;
+  }
+  return result;
+}
+
+Value Flattener::mapUnary(const Value& v, Kind k) {
+  Value r{v.shape, {}};
+  r.elems.reserve(v.size());
+  for (Expr x : v.elems) r.elems.push_back(ctx_.unary(k, x));
+  return r;
+}
+
+Value Flattener::lowerUnary(const UnaryExpr& e) {
+  Value v = lower(*e.operand);
+  switch (e.op) {
+    case UnaryOp::Plus: return v;
+    case UnaryOp::Not: return mapUnary(v, Kind::Not);
+    case UnaryOp::Neg:
+      for (Expr& x : v.elems) x = ctx_.neg(x);
+      return v;
+  }
+  return v;
+}
+
+Value Flattener::lowerBinary(const BinaryExpr& e) {
+  Value a = lower(*e.lhs);
+  Value b = lower(*e.rhs);
+  switch (e.op) {
+    case BinaryOp::Add: case BinaryOp::Sub: case BinaryOp::Div: case BinaryOp::Pow:
+      return lowerArithmetic(e.op, std::move(a), std::move(b), e);
+    case BinaryOp::Mul: return lowerProduct(std::move(a), std::move(b), e);
+    default: break;
+  }
+  if (!a.isScalar() || !b.isScalar())
+    fail(e.opRange, "E0306", std::string("'") + spelling(e.op) + "' needs scalar operands, but got " +
+                                 shapeText(a.shape) + " and " + shapeText(b.shape));
+  Expr x = a.elems[0], y = b.elems[0];
+  switch (e.op) {
+    case BinaryOp::Lt: return Value::scalar(ctx_.binary(Kind::Lt, x, y));
+    case BinaryOp::Le: return Value::scalar(ctx_.binary(Kind::Le, x, y));
+    case BinaryOp::Gt: return Value::scalar(ctx_.binary(Kind::Lt, y, x));
+    case BinaryOp::Ge: return Value::scalar(ctx_.binary(Kind::Le, y, x));
+    case BinaryOp::Eq: return Value::scalar(ctx_.binary(Kind::Eq, x, y));
+    case BinaryOp::Ne: return Value::scalar(ctx_.binary(Kind::Ne, x, y));
+    case BinaryOp::And: return Value::scalar(ctx_.binary(Kind::And, x, y));
+    case BinaryOp::Or: return Value::scalar(ctx_.binary(Kind::Or, x, y));
+    default: break;
+  }
+  fail(e.opRange, "E0399", "unsupported operator");
+}
+
+// + and - need equal shapes; / needs a scalar divisor; ^ needs scalars (Modelica's rules).
+Value Flattener::lowerArithmetic(BinaryOp op, Value a, Value b, const BinaryExpr& e) {
+  std::string opText = spelling(op);
+  if ((op == BinaryOp::Div || op == BinaryOp::Pow) && !b.isScalar())
+    fail(e.rhs->range, "E0306", "the right operand of '" + opText + "' must be a scalar, but it has shape " + shapeText(b.shape));
+  if (op == BinaryOp::Pow && !a.isScalar())
+    fail(e.lhs->range, "E0306", "'^' of an array is not supported", "raise each element: {x[i]^2 for i in 1:n}");
+  if ((op == BinaryOp::Add || op == BinaryOp::Sub) && a.shape != b.shape)
+    fail(e.opRange, "E0307", "shape mismatch: " + shapeText(a.shape) + " " + opText + " " + shapeText(b.shape),
+         "both operands of '" + opText + "' must have the same shape");
+  for (size_t i = 0; i < a.size(); ++i) {
+    Expr y = b.isScalar() ? b.elems[0] : b.elems[i];
+    switch (op) {
+      case BinaryOp::Add: a.elems[i] = ctx_.add(a.elems[i], y); break;
+      case BinaryOp::Sub: a.elems[i] = ctx_.sub(a.elems[i], y); break;
+      case BinaryOp::Div: a.elems[i] = ctx_.div(a.elems[i], y); break;
+      default: a.elems[i] = ctx_.pow(a.elems[i], y); break;
+    }
+  }
+  return a;
+}
+
+// scalar*array, vector*vector (dot), matrix*vector, vector*matrix, matrix*matrix.
+Value Flattener::lowerProduct(Value a, Value b, const BinaryExpr& e) {
+  if (a.isScalar() || b.isScalar()) {
+    Value& arr = a.isScalar() ? b : a;
+    Expr s = a.isScalar() ? a.elems[0] : b.elems[0];
+    for (Expr& x : arr.elems) x = ctx_.mul(x, s);
+    return arr;
+  }
+  auto rows = [](const Value& v) { return v.shape.size() == 1 ? 1 : v.shape[0]; };
+  int inner = a.shape.back();
+  int innerB = b.shape[0];
+  if (a.shape.size() > 2 || b.shape.size() > 2 || inner != innerB)
+    fail(e.opRange, "E0307", "cannot multiply " + shapeText(a.shape) + " by " + shapeText(b.shape),
+         "inner dimensions must agree (matrix*vector, vector*vector, matrix*matrix)");
+  int n = a.shape.size() == 2 ? rows(a) : 1;
+  int p = b.shape.size() == 2 ? b.shape[1] : 1;
+  Value r;
+  if (a.shape.size() == 2) r.shape.push_back(n);
+  if (b.shape.size() == 2) r.shape.push_back(p);
+  std::vector<Expr> terms(inner);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < p; ++j) {
+      for (int k = 0; k < inner; ++k) terms[k] = ctx_.mul(a.elems[i * inner + k], b.elems[k * p + j]);
+      r.elems.push_back(ctx_.add(terms));
+    }
+  return r;
+}
+
+Value Flattener::lowerRange(const RangeExpr& e) {
+  Value v;
+  v.elems = iterationValues(e);
+  v.shape = {static_cast<int>(v.elems.size())};
+  return v;
+}
+
+std::vector<Expr> Flattener::iterationValues(const ast::Expr& range) {
+  auto* r = dyn_cast<RangeExpr>(&range);
+  if (!r) {
+    Value v = lower(range);
+    if (v.shape.size() != 1) fail(range.range, "E0308", "a loop range must be a vector, e.g. 1:n");
+    return v.elems;
+  }
+  if (!r->start || !r->stop) fail(range.range, "E0308", "a loop range needs a start and a stop, e.g. 1:n");
+  double a = lowerConstant(*r->start, "a range bound");
+  double step = r->step ? lowerConstant(*r->step, "a range step") : 1.0;
+  double b = lowerConstant(*r->stop, "a range bound");
+  if (step == 0) fail(r->step->range, "E0308", "a range step cannot be 0");
+  double count = std::floor((b - a) / step + 1e-9) + 1;
+  if (!(count > 0)) return {};
+  countScalars(static_cast<size_t>(count), range.range);
+  std::vector<Expr> out;
+  for (long i = 0; i < static_cast<long>(count); ++i) out.push_back(ctx_.constant(a + i * step));
+  return out;
+}
+
+Value Flattener::stack(std::vector<Value> parts, SourceRange r) {
+  Value v;
+  v.shape.push_back(static_cast<int>(parts.size()));
+  if (parts.empty()) return v;
+  for (size_t i = 1; i < parts.size(); ++i)
+    if (parts[i].shape != parts[0].shape)
+      fail(r, "E0307", "array elements have different shapes: " + shapeText(parts[0].shape) + " and " +
+                           shapeText(parts[i].shape));
+  v.shape.insert(v.shape.end(), parts[0].shape.begin(), parts[0].shape.end());
+  for (auto& p : parts) v.elems.insert(v.elems.end(), p.elems.begin(), p.elems.end());
+  return v;
+}
+
+Value Flattener::lowerArray(const ArrayExpr& e) {
+  std::vector<Value> parts;
+  for (const auto& el : e.elements) parts.push_back(lower(*el));
+  return stack(std::move(parts), e.range);
+}
+
+// {body for i in r1, j in r2}: the first iterator is the first dimension.
+Value Flattener::lowerComprehension(const ComprehensionExpr& e) {
+  std::vector<Value> parts;
+  std::vector<int> dims;
+  for (const auto& it : e.iterators) dims.push_back(static_cast<int>(iterationValues(*it.range).size()));
+  forEachIteration(e.iterators, 0, [&] { parts.push_back(lower(*e.body)); });
+  Value v = stack(std::move(parts), e.range);
+  v.shape.erase(v.shape.begin());
+  v.shape.insert(v.shape.begin(), dims.begin(), dims.end());
+  return v;
+}
+
+Value Flattener::lowerIf(const IfExpr& e) {
+  std::vector<Expr> conds;
+  for (const auto& c : e.conditions) conds.push_back(lowerScalar(*c, "an if-condition"));
+  // Branches known at compile time (Integer parameters) select without evaluating the others.
+  for (size_t i = 0; i < conds.size(); ++i) {
+    if (!conds[i]->isConstant()) break;
+    if (conds[i]->value != 0) return lower(*e.values[i]);
+    if (i + 1 == conds.size()) return lower(*e.elseValue);
+  }
+  Value result = lower(*e.elseValue);
+  for (size_t i = conds.size(); i-- > 0;) {
+    Value branch = lower(*e.values[i]);
+    if (branch.shape != result.shape)
+      fail(e.values[i]->range, "E0307", "the branches of this if-expression have different shapes: " +
+                                            shapeText(branch.shape) + " and " + shapeText(result.shape));
+    for (size_t k = 0; k < result.size(); ++k)
+      result.elems[k] = ctx_.select(conds[i], branch.elems[k], result.elems[k]);
+  }
+  return result;
+}
+
+}  // namespace qdot::flat

@@ -1,0 +1,110 @@
+// FlatModel: one model after flattening — every array, for-loop, reduction and comprehension
+// expanded to scalar variables (`x[1]`, `M[1,2]`), definitions substituted, constants and Integer
+// parameters folded, every expression a symbolic DAG over the variables' symbols. Every equation
+// and energy term remembers the source range it came from. Handed to the mechanics stage.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "support/SourceManager.h"
+#include "symbolic/Expr.h"
+
+namespace qdot::flat {
+
+enum class VarRole {
+  Time,          ///< the independent variable `time`
+  Parameter,     ///< run-time parameter (Real or Boolean); `value` is its default
+  Coordinate,    ///< generalized coordinate q
+  Velocity,      ///< der(q) of a coordinate (a state of the first-order system)
+  Acceleration,  ///< der(der(q))
+  Unknown,       ///< `Real x;`: a state if der(x) appears, otherwise algebraic
+  Derivative,    ///< der(x) of an Unknown
+  Multiplier,    ///< Lagrange multiplier of a constraint
+};
+const char* roleName(VarRole r);
+
+struct Variable {
+  std::string name;  ///< user-facing scalar name: `th[1]`, `der(th[1])`
+  VarRole role = VarRole::Unknown;
+  sym::Expr symbol = nullptr;
+  SourceRange declRange;  ///< the declaration's name (or the der() that created it)
+  std::string description;
+  std::string unit;
+  sym::Expr start = nullptr;  ///< start attribute (over parameters); null if none
+  bool fixed = false;
+  sym::Expr nominal = nullptr, min = nullptr, max = nullptr;
+  sym::Expr value = nullptr;  ///< Parameter: default value (over other parameters)
+  int derivative = -1;        ///< index of the variable that is der(this), -1 if none
+  int derivativeOf = -1;      ///< this is der(variables[derivativeOf])
+};
+
+enum class OriginKind {
+  Equation,         ///< a line of the equation section
+  InitialEquation,  ///< a line of the initial equation section
+  EulerLagrange,    ///< the Euler–Lagrange row of a coordinate
+  Kinematic,        ///< der(q) is the velocity of q
+  Constraint,       ///< a holonomic constraint
+};
+
+/// Where a flat equation came from, for diagnostics (Rumoca's practice).
+struct Origin {
+  OriginKind kind = OriginKind::Equation;
+  SourceRange range;
+  int variable = -1;  ///< EulerLagrange/Kinematic: the coordinate; Constraint: its multiplier
+  std::string element;  ///< for array equations: which element, e.g. "[2]"
+};
+
+/// `residual = 0` (user equations are stored as lhs - rhs).
+struct Equation {
+  sym::Expr residual = nullptr;
+  Origin origin;
+  sym::Expr lhs = nullptr, rhs = nullptr;  ///< the sides as written (for printing), if any
+};
+
+/// One contribution to T, V, D or a generalized force, with the statement it came from.
+struct Term {
+  sym::Expr value = nullptr;
+  SourceRange range;
+};
+
+struct Output {
+  std::string name;
+  sym::Expr value = nullptr;
+  SourceRange range;
+};
+
+struct Experiment {
+  std::optional<double> startTime, stopTime, interval, tolerance;
+};
+
+struct FlatModel {
+  std::string name;
+  std::string description;
+  SourceRange range;
+  std::vector<Variable> variables;
+  std::unordered_map<std::string, int> byName;
+  std::vector<int> symbolToVariable;  ///< indexed by sym symbolId; -1 for non-variable symbols
+  std::vector<Equation> equations;
+  std::vector<Equation> initialEquations;
+  std::vector<Term> kinetic, potential, dissipation;
+  std::vector<std::pair<int, Term>> forces;  ///< (coordinate variable, term)
+  std::vector<Equation> constraints;         ///< g(q, t) = 0, origin.range = the statement
+  std::vector<Output> outputs;
+  Experiment experiment;
+
+  /// The variable a symbol stands for, or -1.
+  int variableOf(sym::Expr s) const {
+    return s->isSymbol() && s->symbolId < symbolToVariable.size() ? symbolToVariable[s->symbolId] : -1;
+  }
+  std::vector<int> variablesWithRole(VarRole r) const {
+    std::vector<int> out;
+    for (int i = 0; i < static_cast<int>(variables.size()); ++i)
+      if (variables[i].role == r) out.push_back(i);
+    return out;
+  }
+};
+
+}  // namespace qdot::flat

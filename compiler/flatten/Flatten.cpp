@@ -1,0 +1,338 @@
+// Flatten: declarations to scalar variables (lazily, so declaration order does not matter),
+// equations and mechanics statements expanded over for-loops, the experiment annotation read.
+#include "flatten/Flatten.h"
+
+#include <cmath>
+
+#include "flatten/Flattener.h"
+
+namespace qdot::flat {
+
+using namespace qdot::ast;
+using sema::SymbolKind;
+using sym::Expr;
+
+// Scalar names in row-major order: x, x[1], M[1,2].
+static std::vector<std::string> scalarNames(const std::string& base, const std::vector<int>& shape) {
+  size_t n = 1;
+  for (int s : shape) n *= static_cast<size_t>(s);
+  std::vector<std::string> names;
+  names.reserve(n);
+  std::vector<int> idx(shape.size(), 1);
+  for (size_t k = 0; k < n; ++k) {
+    std::string name = base;
+    for (size_t i = 0; i < idx.size(); ++i) name += (i ? "," : "[") + std::to_string(idx[i]);
+    names.push_back(idx.empty() ? name : name + "]");
+    for (size_t i = idx.size(); i-- > 0;) {
+      if (++idx[i] <= shape[i]) break;
+      idx[i] = 1;
+    }
+  }
+  return names;
+}
+
+
+const char* roleName(VarRole r) {
+  switch (r) {
+    case VarRole::Time: return "time";
+    case VarRole::Parameter: return "parameter";
+    case VarRole::Coordinate: return "coordinate";
+    case VarRole::Velocity: return "velocity";
+    case VarRole::Acceleration: return "acceleration";
+    case VarRole::Unknown: return "unknown";
+    case VarRole::Derivative: return "derivative";
+    case VarRole::Multiplier: return "multiplier";
+  }
+  return "?";
+}
+
+std::optional<FlatModel> flatten(const sema::CheckedModel& model, sym::Context& ctx, DiagnosticEngine& diags,
+                                 FlattenLimits limits) {
+  return Flattener(model, ctx, diags, limits).run();
+}
+
+Flattener::Flattener(const sema::CheckedModel& m, sym::Context& ctx, DiagnosticEngine& diags, FlattenLimits limits)
+    : m_(m), ctx_(ctx), diags_(diags), limits_(limits) {}
+
+template <class F> void Flattener::guarded(F&& body) {
+  try {
+    body();
+  } catch (FlattenAbort&) {
+  }
+}
+
+void Flattener::forEachIteration(const std::vector<Iterator>& its, size_t k, const std::function<void()>& body) {
+  if (k == its.size()) return body();
+  for (Expr v : iterationValues(*its[k].range)) {
+    iterators_.emplace_back(its[k].name, v);
+    try {
+      forEachIteration(its, k + 1, body);
+    } catch (...) {
+      iterators_.pop_back();
+      throw;
+    }
+    iterators_.pop_back();
+  }
+}
+
+std::optional<FlatModel> Flattener::run() {
+  size_t errorsBefore = diags_.errorCount();
+  out_.name = m_.cls->name;
+  out_.description = m_.cls->description;
+  out_.range = m_.cls->nameRange;
+  addVariable({.name = "time", .role = VarRole::Time, .symbol = ctx_.symbol("time")});
+  for (const auto* d : m_.declarations) guarded([&] { valueOf(*d, d->nameRange); });
+  for (const auto& eq : m_.cls->equations) guarded([&] { lowerEquation(eq, out_.equations, OriginKind::Equation); });
+  for (const auto& eq : m_.cls->initialEquations)
+    guarded([&] { lowerEquation(eq, out_.initialEquations, OriginKind::InitialEquation); });
+  for (const auto& st : m_.cls->mechanics) guarded([&] { lowerMechanics(st); });
+  guarded([&] { lowerExperiment(); });
+  if (diags_.errorCount() > errorsBefore) return std::nullopt;
+  return std::move(out_);
+}
+
+void Flattener::countScalars(size_t n, SourceRange r) {
+  scalars_ += n;
+  if (scalars_ > limits_.maxScalars)
+    fail(r, "E0310", "the model expands to more than " + std::to_string(limits_.maxScalars) + " scalars",
+         "reduce the array sizes or loop ranges");
+}
+
+int Flattener::addVariable(Variable v) {
+  int index = static_cast<int>(out_.variables.size());
+  uint32_t id = v.symbol->symbolId;
+  if (out_.symbolToVariable.size() <= id) out_.symbolToVariable.resize(id + 1, -1);
+  out_.symbolToVariable[id] = index;
+  out_.byName[v.name] = index;
+  out_.variables.push_back(std::move(v));
+  return index;
+}
+
+// der(x) of a variable: created on first use. A coordinate's velocity and a velocity's
+// acceleration have their own roles; a second derivative of any other unknown is refused.
+int Flattener::derivativeVariable(int var, SourceRange where) {
+  if (out_.variables[var].derivative >= 0) return out_.variables[var].derivative;
+  VarRole role = out_.variables[var].role;
+  VarRole derRole = role == VarRole::Coordinate ? VarRole::Velocity
+                    : role == VarRole::Velocity ? VarRole::Acceleration
+                    : role == VarRole::Unknown  ? VarRole::Derivative
+                                                : VarRole::Time;
+  if (derRole == VarRole::Time)
+    fail(where, "E0311", "cannot take the derivative of '" + out_.variables[var].name + "' (a " + roleName(role) + ")",
+         "higher derivatives are only available for coordinates: declare the variable as 'coordinate Real'");
+  std::string name = "der(" + out_.variables[var].name + ")";
+  Variable d{.name = name, .role = derRole, .symbol = ctx_.symbol(name), .declRange = out_.variables[var].declRange};
+  d.derivativeOf = var;
+  int index = addVariable(std::move(d));
+  out_.variables[var].derivative = index;
+  return index;
+}
+
+const Value& Flattener::valueOf(const Declaration& d, SourceRange use) {
+  if (auto it = declValues_.find(&d); it != declValues_.end()) return it->second;
+  if (failed_.count(&d)) throw FlattenAbort{};
+  if (!inProgress_.insert(&d).second)
+    fail(use, "E0312", "the definition of '" + d.name + "' depends on itself",
+         "break the cycle: a definition or parameter cannot refer to itself, directly or through others");
+  Value v;
+  try {
+    v = createDeclaration(d, m_.symbols.at(d.name));
+  } catch (...) {
+    inProgress_.erase(&d);
+    failed_.insert(&d);
+    throw;
+  }
+  inProgress_.erase(&d);
+  return declValues_.emplace(&d, std::move(v)).first->second;
+}
+
+std::vector<int> Flattener::evaluateDims(const Declaration& d) {
+  std::vector<int> shape;
+  size_t total = 1;
+  for (const auto* dims : {&d.typeDims, &d.dims})
+    for (const auto& e : *dims) {
+      long n = lowerInteger(*e, "an array size");
+      if (n < 0) fail(e->range, "E0303", "array size " + std::to_string(n) + " is negative");
+      shape.push_back(static_cast<int>(n));
+      total *= static_cast<size_t>(n);
+      countScalars(static_cast<size_t>(n), e->range);
+    }
+  if (shape.size() > 1) countScalars(total, d.nameRange);
+  return shape;
+}
+
+Value Flattener::createDeclaration(const Declaration& d, const sema::ModelSymbol& s) {
+  std::vector<int> shape = evaluateDims(d);
+  switch (s.kind) {
+    case SymbolKind::Constant:
+    case SymbolKind::IntegerParameter: {
+      Value v = bindingValue(d, shape);
+      for (size_t i = 0; i < v.size(); ++i)
+        if (!v.elems[i]->isConstant())
+          fail(d.binding->range, "E0313", "the value of '" + d.name + "' must be known at compile time",
+               "constants and Integer parameters may only depend on literals and other constants");
+        else if (s.kind == SymbolKind::IntegerParameter && v.elems[i]->value != std::floor(v.elems[i]->value))
+          fail(d.binding->range, "E0313", "Integer parameter '" + d.name + "' has a non-integer value");
+      return v;
+    }
+    case SymbolKind::Definition: {
+      Value v = bindingValue(d, shape);
+      if (d.causality == Causality::Output) {
+        std::vector<std::string> names = scalarNames(d.name, shape);
+        for (size_t i = 0; i < v.size(); ++i) out_.outputs.push_back({names[i], v.elems[i], d.nameRange});
+      }
+      return v;
+    }
+    case SymbolKind::Parameter: {
+      Value vars = variablesFor(d, shape, VarRole::Parameter);
+      Value values = bindingValue(d, shape);
+      for (size_t i = 0; i < vars.size(); ++i) out_.variables[out_.variableOf(vars.elems[i])].value = values.elems[i];
+      return vars;
+    }
+    case SymbolKind::Coordinate:
+    case SymbolKind::Unknown: {
+      bool coord = s.kind == SymbolKind::Coordinate;
+      Value vars = variablesFor(d, shape, coord ? VarRole::Coordinate : VarRole::Unknown);
+      for (Expr x : vars.elems) out_.variables[out_.variableOf(x)].fixed = coord;
+      if (coord)  // every coordinate has a velocity and an acceleration, used or not
+        for (Expr x : vars.elems) derivativeVariable(derivativeVariable(out_.variableOf(x), d.nameRange), d.nameRange);
+      applyAttributes(d, vars);
+      return vars;
+    }
+  }
+  fail(d.range, "E0399", "unsupported declaration");
+}
+
+Value Flattener::variablesFor(const Declaration& d, const std::vector<int>& shape, VarRole role) {
+  Value v{shape, {}};
+  for (std::string& name : scalarNames(d.name, shape)) {
+    Expr symbol = ctx_.symbol(name);
+    addVariable({.name = std::move(name), .role = role, .symbol = symbol, .declRange = d.nameRange,
+                 .description = d.description});
+    v.elems.push_back(symbol);
+  }
+  return v;
+}
+
+void Flattener::checkShape(const Value& v, const std::vector<int>& shape, SourceRange r, const std::string& what) {
+  if (v.shape != shape)
+    fail(r, "E0307", what + " has shape " + shapeText(v.shape) + ", but " + shapeText(shape) + " is needed",
+         shape.empty() ? "give a scalar value" : "give an array of shape " + shapeText(shape) + ", e.g. with fill(value, ...)");
+}
+
+Value Flattener::bindingValue(const Declaration& d, const std::vector<int>& shape) {
+  Value v = lower(*d.binding);
+  checkShape(v, shape, d.binding->range, "the value of '" + d.name + "'");
+  return v;
+}
+
+// start/fixed/nominal/min/max/unit; a scalar value applies to every element of an array.
+void Flattener::applyAttributes(const Declaration& d, const Value& vars) {
+  for (const auto& mod : d.mods) {
+    if (!mod.value) continue;
+    if (mod.name == "unit") {
+      if (auto* s = dyn_cast<StringExpr>(mod.value.get()))
+        for (Expr x : vars.elems) out_.variables[out_.variableOf(x)].unit = s->value;
+      continue;
+    }
+    if (mod.name != "start" && mod.name != "fixed" && mod.name != "nominal" && mod.name != "min" && mod.name != "max")
+      continue;
+    Value v = lower(*mod.value);
+    if (!v.isScalar()) checkShape(v, vars.shape, mod.value->range, "the " + mod.name + " value of '" + d.name + "'");
+    for (size_t i = 0; i < vars.size(); ++i) {
+      Variable& var = out_.variables[out_.variableOf(vars.elems[i])];
+      Expr x = v.isScalar() ? v.elems[0] : v.elems[i];
+      if (mod.name == "start") var.start = x;
+      else if (mod.name == "nominal") var.nominal = x;
+      else if (mod.name == "min") var.min = x;
+      else if (mod.name == "max") var.max = x;
+      else if (!x->isConstant()) fail(mod.value->range, "E0303", "'fixed' must be true or false");
+      else var.fixed = x->value != 0;
+    }
+  }
+}
+
+void Flattener::lowerEquation(const ast::Equation& eq, std::vector<flat::Equation>& into, OriginKind kind) {
+  if (eq.kind == EquationKind::For) {
+    forEachIteration(eq.iterators, 0, [&] {
+      for (const auto& b : eq.body) guarded([&] { lowerEquation(b, into, kind); });
+    });
+    return;
+  }
+  if (eq.kind != EquationKind::Simple || !eq.lhs || !eq.rhs) return;  // sema reported the others
+  Value l = lower(*eq.lhs);
+  Value r = lower(*eq.rhs);
+  if (l.shape != r.shape)
+    fail(eq.range, "E0307", "the two sides of this equation have different shapes: " + shapeText(l.shape) +
+                                " and " + shapeText(r.shape));
+  countScalars(l.size(), eq.range);
+  for (size_t i = 0; i < l.size(); ++i) {
+    std::string element = l.isScalar() ? "" : "[" + std::to_string(i + 1) + "]";
+    into.push_back({ctx_.sub(l.elems[i], r.elems[i]), {kind, eq.range, -1, element}, l.elems[i], r.elems[i]});
+  }
+}
+
+void Flattener::lowerMechanics(const MechanicsStmt& st) {
+  switch (st.kind) {
+    case MechanicsKind::For:
+      forEachIteration(st.iterators, 0, [&] {
+        for (const auto& b : st.body) guarded([&] { lowerMechanics(b); });
+      });
+      return;
+    case MechanicsKind::Kinetic: return addTerms(out_.kinetic, st);
+    case MechanicsKind::Potential: return addTerms(out_.potential, st);
+    case MechanicsKind::Dissipation: return addTerms(out_.dissipation, st);
+    case MechanicsKind::Force: return lowerForce(st);
+    case MechanicsKind::Constraint: {
+      Value l = lower(*st.value), r = lower(*st.rhs);
+      if (l.shape != r.shape) fail(st.range, "E0307", "the two sides of this constraint have different shapes");
+      for (size_t i = 0; i < l.size(); ++i)
+        out_.constraints.push_back(
+            {ctx_.sub(l.elems[i], r.elems[i]), {OriginKind::Constraint, st.range, -1, ""}, l.elems[i], r.elems[i]});
+      return;
+    }
+  }
+}
+
+void Flattener::addTerms(std::vector<Term>& into, const MechanicsStmt& st) {
+  const char* what = st.kind == MechanicsKind::Kinetic ? "a kinetic energy"
+                     : st.kind == MechanicsKind::Potential ? "a potential energy" : "a dissipation function";
+  into.push_back({lowerScalar(*st.value, what), st.range});
+}
+
+void Flattener::lowerForce(const MechanicsStmt& st) {
+  Value target = lower(*st.target);
+  Value value = lower(*st.value);
+  if (target.shape != value.shape)
+    fail(st.value->range, "E0307", "the force has shape " + shapeText(value.shape) + " but its coordinate has shape " +
+                                       shapeText(target.shape));
+  for (size_t i = 0; i < target.size(); ++i) {
+    int var = out_.variableOf(target.elems[i]);
+    if (var < 0 || out_.variables[var].role != VarRole::Coordinate)
+      fail(st.target->range, "E0209", "force(...) must name a coordinate");
+    out_.forces.push_back({var, {value.elems[i], st.range}});
+  }
+}
+
+void Flattener::lowerExperiment() {
+  for (const auto& ann : m_.cls->annotations)
+    for (const auto& mod : ann.mods) {
+      if (mod.name != "experiment") continue;
+      for (const auto& m : mod.nested) {
+        if (!m.value) continue;
+        std::optional<double>* slot = m.name == "StartTime" ? &out_.experiment.startTime
+                                      : m.name == "StopTime"  ? &out_.experiment.stopTime
+                                      : m.name == "Interval"  ? &out_.experiment.interval
+                                      : m.name == "Tolerance" ? &out_.experiment.tolerance
+                                                              : nullptr;
+        if (!slot) {
+          diags_.warning(m.nameRange, "W0301", "unknown experiment setting '" + m.name + "' is ignored",
+                         "the settings are StartTime, StopTime, Interval and Tolerance");
+          continue;
+        }
+        guarded([&] { *slot = lowerConstant(*m.value, "an experiment setting"); });
+      }
+    }
+}
+
+}  // namespace qdot::flat

@@ -1,0 +1,101 @@
+// Flattener internals shared by Flatten.cpp (declarations and statements) and ExprLowering.cpp
+// (AST expressions to arrays of symbolic expressions). Not part of the stage's interface.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <unordered_map>
+#include <unordered_set>
+#include <utility>
+#include <vector>
+
+#include "flatten/Flatten.h"
+
+namespace qdot::flat {
+
+/// An array of symbolic expressions in row-major order; a scalar has an empty shape.
+struct Value {
+  std::vector<int> shape;
+  std::vector<sym::Expr> elems;
+
+  static Value scalar(sym::Expr e) { return {{}, {e}}; }
+  bool isScalar() const { return shape.empty(); }
+  size_t size() const { return elems.size(); }
+};
+
+std::string shapeText(const std::vector<int>& shape);
+
+/// Thrown after an error has been reported, to abandon the current statement and go on with the next.
+struct FlattenAbort {};
+
+class Flattener {
+ public:
+  Flattener(const sema::CheckedModel& m, sym::Context& ctx, DiagnosticEngine& diags, FlattenLimits limits);
+  std::optional<FlatModel> run();
+
+  // --- expression lowering (ExprLowering.cpp) ---
+  Value lower(const ast::Expr& e);
+  sym::Expr lowerScalar(const ast::Expr& e, const char* what);
+  long lowerInteger(const ast::Expr& e, const char* what);
+  double lowerConstant(const ast::Expr& e, const char* what);
+  std::vector<sym::Expr> iterationValues(const ast::Expr& range);
+  sym::Expr timeDerivative(sym::Expr e, SourceRange where);
+
+  [[noreturn]] void fail(SourceRange r, std::string code, std::string msg, std::string help = {});
+
+ private:
+  const sema::CheckedModel& m_;
+  sym::Context& ctx_;
+  DiagnosticEngine& diags_;
+  FlattenLimits limits_;
+  FlatModel out_;
+  size_t scalars_ = 0;
+
+  std::unordered_map<const ast::Declaration*, Value> declValues_;
+  std::unordered_set<const ast::Declaration*> inProgress_;
+  std::unordered_set<const ast::Declaration*> failed_;  ///< already reported; later uses abort quietly
+  std::vector<std::pair<std::string, sym::Expr>> iterators_;  ///< innermost last
+  std::vector<const Value*> endContext_;                      ///< arrays being subscripted (for `end`)
+  std::vector<int> endDim_;
+
+  // Flatten.cpp
+  const Value& valueOf(const ast::Declaration& d, SourceRange use);
+  Value createDeclaration(const ast::Declaration& d, const sema::ModelSymbol& s);
+  std::vector<int> evaluateDims(const ast::Declaration& d);
+  Value variablesFor(const ast::Declaration& d, const std::vector<int>& shape, VarRole role);
+  void applyAttributes(const ast::Declaration& d, const Value& vars);
+  Value bindingValue(const ast::Declaration& d, const std::vector<int>& shape);
+  int addVariable(Variable v);
+  int derivativeVariable(int var, SourceRange where);
+  void checkShape(const Value& v, const std::vector<int>& shape, SourceRange r, const std::string& what);
+  void countScalars(size_t n, SourceRange r);
+  void lowerEquation(const ast::Equation& eq, std::vector<Equation>& into, OriginKind kind);
+  void lowerMechanics(const ast::MechanicsStmt& st);
+  void addTerms(std::vector<Term>& into, const ast::MechanicsStmt& st);
+  void lowerForce(const ast::MechanicsStmt& st);
+  void lowerExperiment();
+  void forEachIteration(const std::vector<ast::Iterator>& its, size_t k, const std::function<void()>& body);
+  template <class F> void guarded(F&& body);
+
+  // ExprLowering.cpp
+  Value lowerName(const ast::NameExpr& n);
+  Value lowerIndex(const ast::IndexExpr& e);
+  Value lowerUnary(const ast::UnaryExpr& e);
+  Value lowerBinary(const ast::BinaryExpr& e);
+  Value lowerArithmetic(ast::BinaryOp op, Value a, Value b, const ast::BinaryExpr& e);
+  Value lowerProduct(Value a, Value b, const ast::BinaryExpr& e);
+  Value lowerCall(const ast::CallExpr& e);
+  Value lowerReduction(const ast::CallExpr& e, bool isSum);
+  Value lowerArrayBuiltin(const std::string& name, const ast::CallExpr& e);
+  Value lowerArray(const ast::ArrayExpr& e);
+  Value lowerComprehension(const ast::ComprehensionExpr& e);
+  Value lowerIf(const ast::IfExpr& e);
+  Value lowerRange(const ast::RangeExpr& e);
+  Value stack(std::vector<Value> parts, SourceRange r);
+  std::vector<int> subscriptIndices(const ast::Expr& s, int dimSize);
+  Value mapUnary(const Value& v, sym::Kind k);
+
+  friend struct IteratorScope;
+};
+
+}  // namespace qdot::flat

@@ -1,0 +1,176 @@
+// Euler–Lagrange rows and first integrals over an index from symbols to energy terms.
+#include "mechanics/EulerLagrange.h"
+
+#include <unordered_map>
+
+namespace qdot::mech {
+namespace {
+
+using flat::VarRole;
+using sym::Expr;
+
+/// The summands of an energy (T with +1, V with −1), each with the variables it contains.
+struct TermIndex {
+  std::vector<Expr> terms;
+  std::unordered_map<int, std::vector<int>> byVariable;  ///< flat variable -> term ids
+  bool dependsOnTime = false;
+
+  const std::vector<int>& termsOf(int var) const {
+    static const std::vector<int> none;
+    auto it = byVariable.find(var);
+    return it == byVariable.end() ? none : it->second;
+  }
+};
+
+class Deriver {
+ public:
+  Deriver(const flat::FlatModel& m, sym::Context& ctx, DiagnosticEngine& diags) : m_(m), ctx_(ctx), diags_(diags) {}
+
+  std::optional<EquationsOfMotion> run() {
+    size_t errorsBefore = diags_.errorCount();
+    index(lagrangian_, m_.kinetic, 1.0);
+    index(lagrangian_, m_.potential, -1.0);
+    index(dissipation_, m_.dissipation, 1.0);
+    makeMultipliers();
+    for (int q : m_.variablesWithRole(VarRole::Coordinate)) derive(q);
+    if (diags_.errorCount() > errorsBefore) return std::nullopt;
+    findFirstIntegrals();
+    out_.kinetic = total(m_.kinetic);
+    out_.potential = total(m_.potential);
+    out_.dissipation = total(m_.dissipation);
+    return std::move(out_);
+  }
+
+ private:
+  const flat::FlatModel& m_;
+  sym::Context& ctx_;
+  DiagnosticEngine& diags_;
+  TermIndex lagrangian_, dissipation_;
+  std::unordered_map<int, std::vector<Expr>> forces_;
+  EquationsOfMotion out_;
+
+  Expr total(const std::vector<flat::Term>& terms) {
+    std::vector<Expr> v;
+    for (const auto& t : terms) v.push_back(t.value);
+    return ctx_.add(v);
+  }
+
+  // Splits every statement into its top-level summands and records which variables each contains.
+  void index(TermIndex& idx, const std::vector<flat::Term>& terms, double sign) {
+    for (const auto& t : terms) {
+      checkEnergyVariables(t);
+      const sym::Node* e = t.value;
+      if (e->kind == sym::Kind::Add) {
+        for (size_t i = 0; i < e->args.size(); ++i) addTerm(idx, ctx_.scale(sign * e->coefs[i], e->args[i]));
+      } else if (!e->isConstant()) {
+        addTerm(idx, ctx_.scale(sign, e));
+      }
+    }
+  }
+
+  void addTerm(TermIndex& idx, Expr term) {
+    int id = static_cast<int>(idx.terms.size());
+    idx.terms.push_back(term);
+    for (Expr s : ctx_.freeSymbols(term)) {
+      int var = m_.variableOf(s);
+      if (var < 0) continue;
+      if (m_.variables[var].role == VarRole::Time) idx.dependsOnTime = true;
+      idx.byVariable[var].push_back(id);
+    }
+  }
+
+  // Energies may depend on coordinates, their velocities, parameters and time only.
+  void checkEnergyVariables(const flat::Term& t) {
+    for (Expr s : ctx_.freeSymbols(t.value)) {
+      int var = m_.variableOf(s);
+      if (var < 0) continue;
+      VarRole r = m_.variables[var].role;
+      if (r == VarRole::Coordinate || r == VarRole::Velocity || r == VarRole::Parameter || r == VarRole::Time) continue;
+      diags_.error(t.range, "E0402",
+                   "this energy depends on '" + m_.variables[var].name + "', which is not a coordinate or its velocity",
+                   r == VarRole::Acceleration ? "energies cannot depend on accelerations"
+                                              : "declare it as 'coordinate Real " + m_.variables[var].name +
+                                                    "', or express it through the coordinates with a definition");
+    }
+  }
+
+  void makeMultipliers() {
+    for (size_t k = 0; k < m_.constraints.size(); ++k) {
+      std::string name = "lambda[" + std::to_string(k + 1) + "]";
+      out_.multipliers.push_back({name, ctx_.symbol(name), static_cast<int>(k)});
+    }
+    for (const auto& [q, term] : m_.forces) forces_[q].push_back(term.value);
+  }
+
+  Expr partial(const TermIndex& idx, int var) {
+    std::vector<Expr> parts;
+    Expr s = m_.variables[var].symbol;
+    for (int t : idx.termsOf(var)) parts.push_back(ctx_.diff(idx.terms[t], s));
+    return ctx_.add(parts);
+  }
+
+  // d/dt of an expression in coordinates, velocities, parameters and time.
+  Expr timeDerivative(Expr e) {
+    std::vector<Expr> terms;
+    for (Expr s : ctx_.freeSymbols(e)) {
+      int var = m_.variableOf(s);
+      if (var < 0) continue;
+      const flat::Variable& v = m_.variables[var];
+      if (v.role == VarRole::Time) terms.push_back(ctx_.diff(e, s));
+      else if (v.role == VarRole::Coordinate || v.role == VarRole::Velocity)
+        terms.push_back(ctx_.mul(ctx_.diff(e, s), m_.variables[v.derivative].symbol));
+    }
+    return ctx_.add(terms);
+  }
+
+  void derive(int q) {
+    const flat::Variable& coord = m_.variables[q];
+    int v = coord.derivative;
+    Expr p = partial(lagrangian_, v);
+    std::vector<Expr> parts{timeDerivative(p), ctx_.neg(partial(lagrangian_, q)), partial(dissipation_, v)};
+    for (Expr f : forces_[q]) parts.push_back(ctx_.neg(f));
+    bool constrained = false;
+    for (const auto& mult : out_.multipliers) {
+      Expr dg = ctx_.diff(m_.constraints[mult.constraint].residual, coord.symbol);
+      constrained |= !dg->isZero();
+      parts.push_back(ctx_.neg(ctx_.mul(mult.symbol, dg)));
+    }
+    Expr residual = ctx_.add(parts);
+    if (lagrangian_.termsOf(q).empty() && lagrangian_.termsOf(v).empty() && forces_[q].empty() && !constrained) {
+      diags_.error(coord.declRange, "E0401", "coordinate '" + coord.name + "' appears in no energy, force or constraint",
+                   "add its kinetic energy in the mechanics section, or declare it as a plain 'Real'");
+      return;
+    }
+    bool inertial = !lagrangian_.termsOf(v).empty() || !dissipation_.termsOf(v).empty();
+    out_.rows.push_back({q, residual, p, inertial});
+  }
+
+  void findFirstIntegrals() {
+    bool conservative = m_.dissipation.empty() && m_.forces.empty() && !lagrangian_.dependsOnTime;
+    std::vector<Expr> jacobi;
+    for (const auto& row : out_.rows) {
+      const flat::Variable& coord = m_.variables[row.coordinate];
+      int v = coord.derivative;
+      jacobi.push_back(ctx_.mul(m_.variables[v].symbol, row.momentum));
+      bool cyclic = lagrangian_.termsOf(row.coordinate).empty() && forces_[row.coordinate].empty() &&
+                    dissipation_.termsOf(v).empty() && !row.momentum->isZero();
+      for (const auto& c : m_.constraints) cyclic &= !ctx_.dependsOn(c.residual, coord.symbol);
+      if (cyclic)
+        out_.integrals.push_back({FirstIntegral::Kind::CyclicMomentum, row.coordinate, "p(" + coord.name + ")", row.momentum});
+    }
+    for (const auto& c : m_.constraints)
+      conservative &= !ctx_.dependsOn(c.residual, m_.variables[m_.byName.at("time")].symbol);
+    if (!conservative) return;
+    jacobi.push_back(ctx_.neg(ctx_.add(lagrangian_.terms)));
+    out_.integrals.push_back({FirstIntegral::Kind::Jacobi, -1, "jacobi", ctx_.add(jacobi)});
+  }
+};
+
+}  // namespace
+
+std::optional<EquationsOfMotion> deriveEquationsOfMotion(const flat::FlatModel& model, sym::Context& ctx,
+                                                         DiagnosticEngine& diags) {
+  return Deriver(model, ctx, diags).run();
+}
+
+}  // namespace qdot::mech

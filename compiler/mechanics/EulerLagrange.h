@@ -1,0 +1,55 @@
+// Mechanics: derives the equations of motion of a FlatModel (spec §5).
+// For every coordinate q with velocity v = der(q):
+//   d/dt(∂L/∂v) − ∂L/∂q + ∂D/∂v − Q_q − Σ_k λ_k ∂g_k/∂q = 0,   L = T − V,
+// with d/dt expanded by the chain rule (q → v, v → der(v), explicit time), so each row is linear in
+// the accelerations. Also finds the first integrals (cyclic momenta, the Jacobi integral).
+// Costs grow with the size of the energies: derivatives are taken only of the energy terms that
+// contain the coordinate (an index from symbols to terms), never of the whole Lagrangian.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "flatten/FlatModel.h"
+#include "support/Diagnostic.h"
+#include "symbolic/Expr.h"
+
+namespace qdot::mech {
+
+/// The Euler–Lagrange row of one coordinate.
+struct CoordinateRow {
+  int coordinate = -1;         ///< flat variable index of q
+  sym::Expr residual = nullptr;  ///< = 0
+  sym::Expr momentum = nullptr;  ///< generalized momentum p = ∂L/∂v
+  /// False when neither T nor D contains der(q): the row is then an algebraic equation for q
+  /// (a massless node, spec §7) and q has no velocity state.
+  bool inertial = true;
+};
+
+struct Multiplier {
+  std::string name;  ///< "lambda[1]"
+  sym::Expr symbol = nullptr;
+  int constraint = -1;  ///< index into FlatModel::constraints
+};
+
+struct FirstIntegral {
+  enum class Kind { CyclicMomentum, Jacobi };
+  Kind kind = Kind::Jacobi;
+  int coordinate = -1;  ///< CyclicMomentum: the cyclic coordinate
+  std::string name;     ///< "p(phi)" or "jacobi"
+  sym::Expr value = nullptr;
+};
+
+struct EquationsOfMotion {
+  std::vector<CoordinateRow> rows;  ///< one per coordinate, in declaration order
+  std::vector<Multiplier> multipliers;
+  std::vector<FirstIntegral> integrals;
+  sym::Expr kinetic = nullptr, potential = nullptr, dissipation = nullptr;  ///< totals T, V, D
+};
+
+/// Derives the rows; reports located errors (E04xx) and returns nullopt on failure.
+std::optional<EquationsOfMotion> deriveEquationsOfMotion(const flat::FlatModel& model, sym::Context& ctx,
+                                                         DiagnosticEngine& diags);
+
+}  // namespace qdot::mech

@@ -1,0 +1,153 @@
+// Internals of the symbolic Context shared by the rule files (not a public header).
+// Holds the node arena and intern table, symbol names, derivative memos, the Add/Mul builders that
+// produce canonical forms, and small helpers for children access and iterative traversal.
+#pragma once
+
+#include <cmath>
+#include <cstring>
+#include <deque>
+#include <limits>
+#include <span>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "symbolic/Expr.h"
+#include "symbolic/NodeMap.h"
+
+namespace qdot::sym {
+
+// --- children: args followed by exps -------------------------------------------------------------
+
+inline size_t childCount(Expr n) { return n->args.size() + n->exps.size(); }
+inline Expr child(Expr n, size_t i) {
+  return i < n->args.size() ? n->args[i] : n->exps[i - n->args.size()];
+}
+
+/// Arity from ExprKinds.def (-1 = n-ary).
+int kindArity(Kind k);
+
+/// Bit identifying a symbol in Node::symbolMask.
+inline uint64_t symbolBit(Expr s) { return uint64_t{1} << (s->symbolId % 64); }
+
+/// Canonical bit pattern of a double for hashing/equality (-0 -> 0, every NaN -> one NaN).
+inline double normalizeNumber(double v) {
+  if (v == 0.0) return 0.0;
+  if (std::isnan(v)) return std::numeric_limits<double>::quiet_NaN();
+  return v;
+}
+inline uint64_t numberBits(double v) {
+  uint64_t b;
+  std::memcpy(&b, &v, sizeof b);
+  return b;
+}
+inline bool isIntegerValue(double v) { return std::isfinite(v) && std::floor(v) == v; }
+
+/// Applies a non-arithmetic kind (Pow, functions, comparisons, logic, select) to numbers.
+/// Shared by constant folding and evaluation so both agree bit for bit.
+double applyKind(Kind k, double a, double b = 0.0, double c = 0.0);
+/// base^exponent with exact fast paths (x^1, x^2, x^-1, x^0.5).
+double powValue(double base, double exponent);
+
+// --- traversal ------------------------------------------------------------------------------------
+
+/// Distinct nodes reachable from roots, children before parents, with each node's position.
+/// Children of a node n are only visited if descend(n) is true (else n is visited as a leaf).
+struct PostOrder {
+  std::vector<Expr> order;
+  NodeMap<uint32_t> index;
+};
+template <class Descend>
+PostOrder postOrder(std::span<const Expr> roots, Descend&& descend) {
+  PostOrder po;
+  std::vector<std::pair<Expr, uint32_t>> stack;
+  for (Expr root : roots) {
+    if (!po.index.insert(root, 0).second) continue;
+    stack.push_back({root, 0});
+    while (!stack.empty()) {
+      Expr n = stack.back().first;
+      uint32_t i = stack.back().second;
+      if (i < childCount(n) && descend(n)) {
+        stack.back().second = i + 1;
+        Expr c = child(n, i);
+        if (po.index.insert(c, 0).second) stack.push_back({c, 0});
+      } else {
+        *po.index.find(n) = static_cast<uint32_t>(po.order.size());
+        po.order.push_back(n);
+        stack.pop_back();
+      }
+    }
+  }
+  return po;
+}
+inline PostOrder postOrder(std::span<const Expr> roots) {
+  return postOrder(roots, [](Expr) { return true; });
+}
+
+// --- the Context internals ------------------------------------------------------------------------
+
+struct Context::Impl {
+  explicit Impl(Context& c) : ctx(c) {}
+
+  Context& ctx;
+  std::deque<Node> nodes;           ///< arena; addresses are stable
+  std::vector<Expr> table;          ///< open-addressing intern table (power-of-two size)
+  size_t tableUsed = 0;
+  std::unordered_map<std::string, Expr> symbolsByName;
+  std::deque<std::string> symbolNames;  ///< by symbolId (deque keeps references stable)
+  std::vector<Expr> symbols;            ///< by symbolId
+  std::vector<NodeMap<Expr>> diffMemo;  ///< by symbolId: node -> derivative
+
+  /// Returns the unique node structurally equal to n (fills hash, mask, depth), creating it if new.
+  Expr intern(Node&& n);
+  /// A Mul node from already canonical, sorted, merged (base, exponent) pairs; applies the
+  /// single-factor rules (no factor -> constant, one factor with coef 1 -> base or Pow).
+  Expr makeMul(double coef, std::vector<Expr>&& bases, std::vector<Expr>&& exps);
+  /// Rebuilds n with new children (args then exps), re-simplifying. Returns n if unchanged.
+  Expr rebuild(Expr n, std::span<const Expr> kids);
+
+ private:
+  void growTable();
+};
+
+/// Accumulates constant + Σ coef·term and builds the canonical Add (flattening nested sums and
+/// moving numeric coefficients of products into the term coefficients).
+class AddBuilder {
+ public:
+  explicit AddBuilder(Context& ctx) : ctx_(ctx) {}
+  void add(double coef, Expr e);
+  void addConstant(double v) { constants_.push_back(v); }
+  Expr build();
+
+ private:
+  Context& ctx_;
+  std::vector<double> constants_;  // summed in sorted order: the result is permutation invariant
+  std::vector<std::pair<Expr, double>> terms_;
+};
+
+/// Accumulates coef · Π base^exp and builds the canonical Mul (collecting equal bases).
+class MulBuilder {
+ public:
+  explicit MulBuilder(Context& ctx, double coef = 1.0) : ctx_(ctx) {
+    if (coef != 1.0) coefs_.push_back(coef);
+  }
+  /// Multiplies by an arbitrary expression (decomposes Mul and Pow).
+  void factor(Expr f);
+  /// Multiplies by b^e.
+  void power(Expr b, Expr e);
+  /// Multiplies by a (base, exponent) pair taken from a canonical Mul, as is.
+  void pair(Expr b, Expr e) { pairs_.emplace_back(b, e); }
+  void scale(double c) { coefs_.push_back(c); }
+  Expr build();
+
+ private:
+  void mergeEqualBases();
+  Expr sumExponents(size_t begin, size_t end);
+  bool redecompose();
+  double coefficient();
+  Context& ctx_;
+  std::vector<double> coefs_;  // multiplied in sorted order: the result is permutation invariant
+  std::vector<std::pair<Expr, Expr>> pairs_;
+};
+
+}  // namespace qdot::sym

@@ -1,0 +1,61 @@
+// NodeMap<V>: a small open-addressing hash map keyed by node pointer, used for per-call memos
+// (evaluation tapes, substitute, CSE) and the per-symbol derivative memo. Linear probing,
+// power-of-two capacity, no erase; an empty map allocates nothing.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "symbolic/Expr.h"
+
+namespace qdot::sym {
+
+template <class V>
+class NodeMap {
+ public:
+  /// Pointer to the value stored for k, or nullptr.
+  V* find(Expr k) {
+    if (slots_.empty()) return nullptr;
+    for (size_t i = slotOf(k);; i = (i + 1) & mask()) {
+      if (slots_[i].first == k) return &slots_[i].second;
+      if (slots_[i].first == nullptr) return nullptr;
+    }
+  }
+  const V* find(Expr k) const { return const_cast<NodeMap*>(this)->find(k); }
+
+  /// Inserts (k, v) unless k is present; returns the stored value and whether it was inserted.
+  std::pair<V*, bool> insert(Expr k, V v) {
+    if ((size_ + 1) * 4 > slots_.size() * 3) grow();
+    for (size_t i = slotOf(k);; i = (i + 1) & mask()) {
+      if (slots_[i].first == k) return {&slots_[i].second, false};
+      if (slots_[i].first == nullptr) {
+        slots_[i] = {k, std::move(v)};
+        ++size_;
+        return {&slots_[i].second, true};
+      }
+    }
+  }
+
+  size_t size() const { return size_; }
+
+ private:
+  size_t mask() const { return slots_.size() - 1; }
+  size_t slotOf(Expr k) const {
+    uint64_t h = reinterpret_cast<uintptr_t>(k) * 0x9E3779B97F4A7C15ull;
+    return static_cast<size_t>(h ^ (h >> 32)) & mask();
+  }
+  void grow() {
+    std::vector<std::pair<Expr, V>> old(slots_.empty() ? 16 : slots_.size() * 2);
+    old.swap(slots_);
+    size_ = 0;
+    for (auto& s : old)
+      if (s.first) insert(s.first, std::move(s.second));
+  }
+
+  std::vector<std::pair<Expr, V>> slots_;
+  size_t size_ = 0;
+};
+
+}  // namespace qdot::sym

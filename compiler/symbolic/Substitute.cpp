@@ -1,0 +1,32 @@
+// Context::substitute: replaces nodes (normally symbols) by expressions, all at once, and rebuilds
+// the ancestors through the canonical constructors. One post-order pass with a per-call memo: each
+// distinct node is visited once, and subtrees whose symbol mask misses every key are not entered.
+#include "symbolic/ContextImpl.h"
+
+namespace qdot::sym {
+
+Expr Context::substitute(Expr e, const std::unordered_map<Expr, Expr>& map) {
+  if (map.empty()) return e;
+  uint64_t keyMask = 0;
+  for (auto& [from, to] : map) keyMask |= from->symbolMask;
+  auto enter = [&](Expr n) { return (n->symbolMask & keyMask) && !map.count(n); };
+  PostOrder po = postOrder(std::span<const Expr>(&e, 1), enter);
+
+  std::vector<Expr> result(po.order.size());
+  std::vector<Expr> kids;
+  for (size_t i = 0; i < po.order.size(); ++i) {
+    Expr n = po.order[i];
+    if (auto it = map.find(n); it != map.end()) {
+      result[i] = it->second;
+    } else if (!enter(n) || childCount(n) == 0) {
+      result[i] = n;
+    } else {
+      kids.clear();
+      for (size_t c = 0; c < childCount(n); ++c) kids.push_back(result[*po.index.find(child(n, c))]);
+      result[i] = impl_->rebuild(n, kids);
+    }
+  }
+  return result.back();
+}
+
+}  // namespace qdot::sym
