@@ -99,8 +99,22 @@ std::vector<int> Flattener::subscriptIndices(const ast::Expr& s, int dimSize) {
   return idx;
 }
 
+// The array being subscripted, without copying it when it is a declared name (x[i] in a loop
+// over a large array must not copy x each time).
+const Value& Flattener::subscriptBase(const ast::Expr& e, Value& holder) {
+  if (auto* n = dyn_cast<NameExpr>(&e)) {
+    bool isIterator = false;
+    for (const auto& it : iterators_) isIterator |= it.first == n->parts[0];
+    auto s = m_.symbols.find(n->parts[0]);
+    if (!isIterator && s != m_.symbols.end()) return valueOf(*s->second.decl, n->range);
+  }
+  holder = lower(e);
+  return holder;
+}
+
 Value Flattener::lowerIndex(const IndexExpr& e) {
-  Value base = lower(*e.base);
+  Value holder;
+  const Value& base = subscriptBase(*e.base, holder);
   if (e.subscripts.size() != base.shape.size())
     fail(e.range, "E0305",
          std::to_string(e.subscripts.size()) + " subscript(s) given for an array of shape " + shapeText(base.shape),

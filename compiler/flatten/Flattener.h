@@ -80,6 +80,7 @@ class Flattener {
   // ExprLowering.cpp
   Value lowerName(const ast::NameExpr& n);
   Value lowerIndex(const ast::IndexExpr& e);
+  const Value& subscriptBase(const ast::Expr& e, Value& holder);
   Value lowerUnary(const ast::UnaryExpr& e);
   Value lowerBinary(const ast::BinaryExpr& e);
   Value lowerArithmetic(ast::BinaryOp op, Value a, Value b, const ast::BinaryExpr& e);

@@ -164,7 +164,9 @@ class Evaluator {
 
 /// The deterministic structural total order used for canonical Add terms and Mul factors (and so
 /// for printing): by kind (ExprKinds.def order), then constant value / symbolId (creation order),
-/// then depth, then children lexicographically, then coefficients. Never uses pointers or hashes.
+/// then depth, then children lexicographically, then coefficients. Never uses pointers. To keep a
+/// comparison O(1), nodes that still agree after 12 levels of descent are ordered by their
+/// structural hash (a function of kinds, values and symbolIds only, so still run-independent).
 /// Returns <0, 0 (same node), >0.
 int structuralCompare(Expr a, Expr b);
 

@@ -1,6 +1,8 @@
 // structuralCompare: the deterministic total order of canonical Add terms and Mul factors.
 // Iterative: because equal subtrees are the same node, two distinct nodes with equal shallow keys
-// differ in their first differing child, so the comparison walks one path down (O(depth)).
+// differ in their first differing child, so the comparison walks one path down. The walk is cut
+// after 12 levels, where the structural hash (built from kinds, values and symbol ids, never from
+// addresses) decides, so comparing two long look-alike chains stays O(1).
 #include "symbolic/ContextImpl.h"
 
 namespace qdot::sym {
@@ -35,12 +37,16 @@ int tieBreak(Expr a, Expr b) {
   return cmpNumber(a->value, b->value);
 }
 
-}  // namespace
-
-int structuralCompare(Expr a, Expr b) {
+// Lexicographic over (shallow key, children, tie-break). After `levels` descents the structural
+// hash decides (then an unbounded descent on a hash collision), so one comparison costs O(levels).
+int compareWithin(Expr a, Expr b, int levels) {
   while (a != b) {
     if (int c = shallowCompare(a, b)) return c;
     if (a->kind == Kind::Constant || a->kind == Kind::Symbol) return 0;  // equal leaves are one node
+    if (levels-- == 0) {
+      if (a->hash != b->hash) return cmp(a->hash, b->hash);
+      levels = -1;  // hash collision: unbounded descent
+    }
     size_t n = std::min(childCount(a), childCount(b)), i = 0;
     while (i < n && child(a, i) == child(b, i)) ++i;
     if (i == n) return tieBreak(a, b);
@@ -49,5 +55,9 @@ int structuralCompare(Expr a, Expr b) {
   }
   return 0;
 }
+
+}  // namespace
+
+int structuralCompare(Expr a, Expr b) { return compareWithin(a, b, 12); }
 
 }  // namespace qdot::sym

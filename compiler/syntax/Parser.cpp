@@ -29,6 +29,15 @@ ast::ClassKind classKindOf(TokenKind k) {
   }
 }
 
+bool isClassKeyword(TokenKind k) {
+  switch (k) {
+    case TokenKind::kw_model: case TokenKind::kw_connector: case TokenKind::kw_package:
+    case TokenKind::kw_record: case TokenKind::kw_block: case TokenKind::kw_function:
+    case TokenKind::kw_type: return true;
+    default: return false;
+  }
+}
+
 bool isMechanicsWord(const Token& t) {
   return t.isWord("kinetic") || t.isWord("potential") || t.isWord("dissipation") || t.isWord("force");
 }
@@ -69,14 +78,7 @@ bool Parser::accept(TokenKind k) {
   return true;
 }
 
-bool Parser::atClassKeyword() {
-  switch (tok().kind) {
-    case TokenKind::kw_model: case TokenKind::kw_connector: case TokenKind::kw_package:
-    case TokenKind::kw_record: case TokenKind::kw_block: case TokenKind::kw_function:
-    case TokenKind::kw_type: return true;
-    default: return false;
-  }
-}
+bool Parser::atClassKeyword() { return isClassKeyword(tok().kind); }
 
 bool Parser::atPrefixKeyword() {
   switch (tok().kind) {
@@ -122,8 +124,37 @@ bool Parser::atStatementListEnd(bool nested) {
   switch (tok().kind) {
     case TokenKind::eof: case TokenKind::kw_end: return true;
     case TokenKind::kw_else: case TokenKind::kw_elseif: case TokenKind::kw_elsewhen: return nested;
-    default: return atSectionStart() || atElementStart();
+    default: return atSectionStart() || atElementStart() || atUnsupportedWord();
   }
+}
+
+/// Modelica words this language does not have: `algorithm`, `protected`, `public` (sections) and
+/// `partial` (before a class keyword). They are identifiers, so only their position tells.
+bool Parser::atUnsupportedWord() {
+  const Token& t = tok();
+  if (t.isNot(TokenKind::identifier)) return false;
+  TokenKind next = peek(1).kind;
+  if (t.isWord("partial")) return isClassKeyword(next);
+  if (!t.isWord("algorithm") && !t.isWord("protected") && !t.isWord("public")) return false;
+  return next != TokenKind::equal && next != TokenKind::dot && next != TokenKind::lBracket && next != TokenKind::lParen;
+}
+
+/// Reports an unsupported Modelica word (E0119) and skips it; an `algorithm` section is skipped
+/// whole, up to the next section or the end of the class.
+bool Parser::skipUnsupported() {
+  bool initialAlgorithm = at(TokenKind::kw_initial) && peek(1).isWord("algorithm");
+  if (!initialAlgorithm && !atUnsupportedWord()) return false;
+  if (initialAlgorithm) take();
+  std::string word(tok().text);
+  const char* help = word == "partial" ? "remove 'partial'"
+                     : word == "algorithm" ? "write the relations as equations in an 'equation' section"
+                                           : "remove it; all declarations are public and come before the first section";
+  report(tok().range, "E0119", quote(word) + (word == "partial" ? " classes are" : " sections are") + " not supported",
+         help);
+  take();
+  if (word != "algorithm") return true;
+  while (!at(TokenKind::eof) && !atSectionStart() && !(at(TokenKind::kw_end) && atSyncPoint())) take();
+  return true;
 }
 
 /// sync_point := ";" | "end" (IDENT | "for" | "if" | "when" | ";") | section keyword
@@ -217,10 +248,8 @@ void Parser::skipToSyncPoint() {
 
 /// Leaves panic mode: skips to a synchronisation point and consumes a ';' found there.
 void Parser::synchronize() {
-  if (!prev_.is(TokenKind::semi)) {
-    skipToSyncPoint();
-    accept(TokenKind::semi);
-  }
+  skipToSyncPoint();
+  accept(TokenKind::semi);
   panic_ = false;
 }
 
@@ -288,6 +317,8 @@ std::unique_ptr<ast::StoredDefinition> Parser::parseStoredDefinition() {
     } else if (atClassKeyword()) {
       panic_ = false;
       def->classes.push_back(parseClass());
+    } else if (skipUnsupported()) {
+      continue;
     } else {
       if (!panic_) failExpected("'model', 'connector' or 'package'", "E0120", "a .qd file contains classes: model M ... end M;");
       reported = true;
@@ -374,6 +405,7 @@ void Parser::parseComposition(ast::ClassDef& cls) {
   SourceRange firstSection;
   while (!at(TokenKind::eof) && !at(TokenKind::kw_end)) {
     uint64_t start = consumed_;
+    if (skipUnsupported()) continue;
     if (atSectionStart()) {
       if (!firstSection.valid()) firstSection = tok().range;
       parseSection(cls);

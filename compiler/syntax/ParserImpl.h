@@ -95,6 +95,8 @@ class Parser {
   bool atElementStart();
   bool atDeclarationStart();
   bool atStatementListEnd(bool nested);
+  bool atUnsupportedWord();
+  bool skipUnsupported();
   bool atSyncPoint();
   SourceRange rangeFrom(uint32_t begin) const { return {file_, begin, prev_.range.end}; }
   SourceRange afterPrev() const { return {file_, prev_.range.end, prev_.range.end}; }

@@ -114,6 +114,13 @@ const BadInput kBadInputs[] = {
      "expected a name after the type 'Real', found '='", ""},
     {"bad modification", "model M\n  Real x(= 1);\nend M;\n", "2:10", "E0116", "expected a name in the modification", ""},
     {"else without if", "model M\nequation\n  else x = 1;\nend M;\n", "3:3", "E0123", "expected an equation, found 'else'", ""},
+    {"algorithm section", "model M\n  Real x;\nequation\n  x = 1;\nalgorithm\n  x := 2;\n  y := x;\nequation\n  y = 1;\nend M;\n",
+     "5:1", "E0119", "'algorithm' sections are not supported", "equation"},
+    {"protected section", "model M\nprotected\n  Real x;\nend M;\n", "2:1", "E0119", "'protected' sections are not supported",
+     ""},
+    {"partial class", "partial model M\nend M;\n", "1:1", "E0119", "'partial' classes are not supported", "remove"},
+    {"when with else", "model M\nequation\n  when c then\n    y = 1;\n  else\n    y = 2;\n  end when;\nend M;\n", "5:3",
+     "E0117", "expected 'end when', found 'else'", ""},
     {"connect without comma", "model M\nequation\n  connect(a b);\nend M;\n", "3:13", "E0117",
      "expected ',' between the two connectors, found identifier 'b'", ""},
 };
