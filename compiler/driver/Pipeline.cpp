@@ -21,9 +21,15 @@ bool runStages(Compilation& c, uint32_t file, std::string_view model, Stage unti
   if (c.diags.hasErrors() || until == Stage::Parse) return !c.diags.hasErrors();
   c.checked = timed(c.times.check, [&] { return sema::checkModel(*c.ast, model, c.diags); });
   if (!c.checked) {
-    c.diags.error({file, 0, 0}, "E0200",
-                  model.empty() ? "this file declares no model" : "there is no model named '" + std::string(model) + "'",
-                  model.empty() ? "declare one: model Name ... end Name;" : "check the name given with --model");
+    if (model.empty()) {
+      c.diags.error({file, 0, 0}, "E0200", "this file declares no model", "declare one: model Name ... end Name;");
+    } else {
+      std::string names;
+      for (const auto& cls : c.ast->classes)
+        if (cls->kind == ast::ClassKind::Model) names += (names.empty() ? "" : ", ") + cls->name;
+      c.diags.error({}, "E0200", "there is no model named '" + std::string(model) + "' in " + c.sources.name(file),
+                    names.empty() ? "the file declares no model" : "the file declares: " + names);
+    }
     return false;
   }
   if (c.diags.hasErrors() || until == Stage::Check) return !c.diags.hasErrors();

@@ -69,6 +69,15 @@ int main(int argc, char** argv) {
   eqs->add_flag("--json", o.json, "print JSON for tools instead of text");
   eqs->add_flag("--timings", o.timings, "print the time each stage took");
 
+  std::string first = argc > 1 ? argv[1] : "";
+  if (!first.empty() && first[0] != '-' && first != "check" && first != "equations") {
+    std::cerr << "qdot: unknown command '" << argv[1] << "'; the commands are: check, equations (see qdot --help)\n";
+    return 2;
+  }
+  if (argc == 1) {
+    std::cout << app.help();
+    return 2;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

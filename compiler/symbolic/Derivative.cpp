@@ -1,6 +1,7 @@
 // Symbolic differentiation: one rule per kind (the switch in `rule` has no default, so a new kind
 // without a rule triggers -Wswitch) and Context::diff, which walks the DAG iteratively in post-order,
 // memoising ∂n/∂s per (node, symbol) in the Context and skipping nodes whose symbol mask lacks s.
+// The memo doubles as the visited set, so a call costs O(nodes not yet differentiated w.r.t. s).
 #include <stdexcept>
 
 #include "symbolic/ContextImpl.h"
@@ -62,10 +63,12 @@ Expr dMul(const Diff& D, Expr n) {
   for (size_t i = 0; i < m; ++i) {
     Expr b = n->args[i], e = n->exps[i];
     if (!((b->symbolMask | e->symbolMask) & symbolBit(D.s))) continue;
+    Expr dFactor = powRule(D, b, e, nullptr);
+    if (dFactor->isZero()) continue;  // the mask only said "maybe"
     MulBuilder term(D.ctx, n->value);
     for (size_t j = 0; j < m; ++j)
       if (j != i) term.pair(n->args[j], n->exps[j]);
-    term.factor(powRule(D, b, e, nullptr));
+    term.factor(dFactor);
     sum.add(1.0, term.build());
   }
   return sum.build();
@@ -166,11 +169,21 @@ Expr Context::diff(Expr e, Expr s) {
   NodeMap<Expr>& memo = memos[s->symbolId];
   if (Expr* known = memo.find(e)) return *known;
 
-  auto pending = [&](Expr n) { return (n->symbolMask & bit) && !memo.find(n); };
-  PostOrder po = postOrder(std::span<const Expr>(&e, 1), pending);
+  // Depth-first post-order over the nodes that may contain s and have no memo yet. The memo is the
+  // visited set: a child is finished (memoised) before its next sibling is looked at.
   Diff D{*this, s, memo};
-  for (Expr n : po.order)
-    if (pending(n)) memo.insert(n, rule(D, n));
+  std::vector<std::pair<Expr, uint32_t>> stack{{e, 0}};
+  while (!stack.empty()) {
+    auto& [n, next] = stack.back();
+    if (next < childCount(n)) {
+      Expr c = child(n, next++);
+      if ((c->symbolMask & bit) && !memo.find(c)) stack.push_back({c, 0});
+    } else {
+      Expr node = n;
+      stack.pop_back();
+      memo.insert(node, rule(D, node));
+    }
+  }
   return *memo.find(e);
 }
 

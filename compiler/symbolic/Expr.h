@@ -12,8 +12,12 @@
 //           with coef 1 is that factor (or a Pow). Products of sums are NOT expanded; a numeric
 //           coefficient times an Add is kept as a Mul (no distribution), so sizes stay linear.
 //   * Pow:  base ^ exponent with both folded when constant; x^0 = 1, x^1 = x, (x^a)^b = x^(a*b)
-//           for integer b.
+//           for integer b. An integer power of a product distributes over its factors
+//           ((2*x*y)^-1 = 0.5*x^-1*y^-1), so a/(b*c) and a*b^-1*c^-1 are one node.
 //   * functions fold on constant arguments (sin(0) = 0, exp(0) = 1, ...); x - x = 0, x / x = 1.
+//     min, max, ==, <>, and, or order their arguments (min(x, y) is min(y, x)); min(a, a) = a,
+//     a < a = 0, a <= a = 1, x and 0 = 0, x or 1 = 1, if c then a else a = a.
+//   * The sign of zero is not kept (-0 is 0, 0*x is 0), and NaN constants are one node.
 // Subtraction a - b is a + (-1)*b; division a / b is a * b^-1; sqrt(x) is x^0.5.
 //
 // Costs the later stages rely on: building a node is O(arity) amortised (O(n log n) for an n-ary
@@ -111,6 +115,7 @@ class Context {
   /// abs, sign, min, max, comparisons and select differentiate piecewise (sign(x)*x' etc.).
   Expr diff(Expr e, Expr s);
   /// Replaces symbols by expressions (all at once, not recursively) and re-simplifies.
+  /// A key may also be any other node, which is then replaced wherever it occurs as a node.
   Expr substitute(Expr e, const std::unordered_map<Expr, Expr>& map);
 
   /// True if symbol s occurs in e (exact; uses the mask to answer "no" fast).
@@ -133,8 +138,10 @@ class Context {
 
 // --- evaluation --------------------------------------------------------------------------------
 
-/// Evaluates e with symbol values indexed by symbolId (values.size() >= symbolCount()).
-/// Booleans are 1.0/0.0. Follows IEEE semantics (sqrt(-1) = NaN, log(0) = -inf).
+/// Evaluates e with symbol values indexed by symbolId (values.size() >= symbolCount(); precisely,
+/// every symbol in e must be covered, else std::invalid_argument). Booleans are 1.0/0.0, any
+/// non-zero value is true. Follows IEEE semantics (sqrt(-1) = NaN, log(0) = -inf); sign(0) = 0,
+/// min/max are fmin/fmax. Iterative: cost is the DAG size, any depth is fine.
 double evaluate(Expr e, std::span<const double> values);
 
 /// Evaluates many roots sharing one memo (each node computed once).
@@ -173,8 +180,9 @@ int structuralCompare(Expr a, Expr b);
 // --- printing ----------------------------------------------------------------------------------
 
 /// Infix text with minimal parentheses, Modelica-like: `rho*A*l*der(v) + 2*rho*A*g*x`,
-/// `x^2`, `-(a*b)`, `sin(th[1])`, `if c then a else b`, comparisons as `<`, `<=`, `==`, `<>`.
-/// Numbers in shortest round-trip form. Terms of a sum print with a leading minus as ` - `.
+/// `x^2`, `-a*b`, `-(a + b)`, `a/(b*c)`, `sqrt(x)`, `sin(th[1])`, `if c then a else b`,
+/// comparisons as `<`, `<=`, `==`, `<>`. Numbers in shortest round-trip form. Terms of a sum print
+/// in canonical order with a leading minus as ` - `, the constant term last (`x - 1`).
 std::string toString(const Context& ctx, Expr e);
 
 // --- common-subexpression elimination ----------------------------------------------------------

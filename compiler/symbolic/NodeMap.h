@@ -43,8 +43,10 @@ class NodeMap {
  private:
   size_t mask() const { return slots_.size() - 1; }
   size_t slotOf(Expr k) const {
-    uint64_t h = reinterpret_cast<uintptr_t>(k) * 0x9E3779B97F4A7C15ull;
-    return static_cast<size_t>(h ^ (h >> 32)) & mask();
+    uint64_t h = reinterpret_cast<uintptr_t>(k);
+    h = (h ^ (h >> 31)) * 0x7FB5D329728EA185ull;
+    h = (h ^ (h >> 27)) * 0x81DADEF4BC2DD44Dull;
+    return static_cast<size_t>(h ^ (h >> 33)) & mask();
   }
   void grow() {
     std::vector<std::pair<Expr, V>> old(slots_.empty() ? 16 : slots_.size() * 2);

@@ -4,6 +4,8 @@
 // `if c then a else b`. Term and factor order is the canonical (structural) order of the node.
 #include <charconv>
 #include <cmath>
+#include <deque>
+#include <string_view>
 
 #include "symbolic/ContextImpl.h"
 
@@ -59,9 +61,10 @@ int precedence(Expr n) {
   return Primary;
 }
 
-// A pending piece of output: literal text, or a node to print at a minimum precedence.
+// A pending piece of output: text (a literal, a symbol name or a number kept by the Printer), or a
+// node to print at a minimum precedence.
 struct Task {
-  std::string text;
+  std::string_view text;
   Expr node = nullptr;
   int minPrec = 0;
 };
@@ -73,7 +76,7 @@ class Printer {
   std::string run(Expr root) {
     stack_.push_back({"", root, IfExpr});
     while (!stack_.empty()) {
-      Task t = std::move(stack_.back());
+      Task t = stack_.back();
       stack_.pop_back();
       if (t.node)
         expand(t.node, t.minPrec);
@@ -84,8 +87,9 @@ class Printer {
   }
 
  private:
-  void text(std::string s) { seq_.push_back({std::move(s), nullptr, 0}); }
-  void node(Expr n, int minPrec) { seq_.push_back({"", n, minPrec}); }
+  void text(std::string_view s) { seq_.push_back({s, nullptr, 0}); }
+  void numberText(double v) { text(numbers_.emplace_back(number(v))); }
+  void node(Expr n, int minPrec) { seq_.push_back({{}, n, minPrec}); }
 
   // Schedules the pieces of n (in reading order) on the stack.
   void expand(Expr n, int minPrec) {
@@ -94,7 +98,7 @@ class Printer {
     if (parens) text("(");
     body(n);
     if (parens) text(")");
-    for (size_t i = seq_.size(); i-- > 0;) stack_.push_back(std::move(seq_[i]));
+    stack_.insert(stack_.end(), seq_.rbegin(), seq_.rend());
   }
 
   // base^exp for a factor of a product; expValue is the (positive) exponent when constant.
@@ -110,13 +114,13 @@ class Printer {
     if (exp)
       node(exp, Primary);
     else
-      text(number(expValue));
+      numberText(expValue);
   }
 
   // |coef| * Π b_i^e_i with negative constant exponents moved to a denominator.
   void product(double absCoef, std::span<const Expr> bases, std::span<const Expr> exps) {
     bool any = false;
-    if (absCoef != 1.0) text(number(absCoef)), any = true;
+    if (absCoef != 1.0) numberText(absCoef), any = true;
     size_t denominators = 0;
     for (size_t i = 0; i < bases.size(); ++i) {
       if (isNegativeConstant(exps[i])) {
@@ -157,11 +161,14 @@ class Printer {
       else if (c < 0.0) text("-");
       term(std::fabs(c), n->args[i]);
     }
-    if (n->value != 0.0) text((n->value < 0.0 ? " - " : " + ") + number(std::fabs(n->value)));
+    if (n->value == 0.0) return;
+    text(n->value < 0.0 ? " - " : " + ");
+    numberText(std::fabs(n->value));
   }
 
   void call(Expr n) {
-    text(std::string(kindSpelling(n->kind)) + "(");
+    text(kindSpelling(n->kind));
+    text("(");
     for (size_t i = 0; i < n->args.size(); ++i) {
       if (i) text(", ");
       node(n->args[i], IfExpr);
@@ -177,7 +184,7 @@ class Printer {
 
   void body(Expr n) {
     switch (n->kind) {
-      case Kind::Constant: return text(number(n->value));
+      case Kind::Constant: return numberText(n->value);
       case Kind::Symbol: return text(ctx_.symbolName(n));
       case Kind::Add: return sum(n);
       case Kind::Mul:
@@ -222,6 +229,7 @@ class Printer {
 
   const Context& ctx_;
   std::vector<Task> stack_, seq_;
+  std::deque<std::string> numbers_;  // storage behind number Tasks (stable addresses)
   std::string out_;
 };
 

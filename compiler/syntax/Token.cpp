@@ -35,11 +35,21 @@ const auto& sortedKeywords() {
   return table;
 }
 
-// Shortens a token's text for a message (long strings, garbage).
+// Shortens a token's text for a message (long strings) and keeps it on one line.
 std::string clip(std::string_view text) {
   constexpr size_t kMax = 24;
-  if (text.size() <= kMax) return std::string(text);
-  return std::string(text.substr(0, kMax)) + "...";
+  std::string out;
+  for (char c : text.substr(0, kMax)) {
+    if (c == '\n') {
+      out += "\\n";
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      out += '?';
+    } else {
+      out += c;
+    }
+  }
+  if (text.size() > kMax) out += "...";
+  return out;
 }
 
 }  // namespace

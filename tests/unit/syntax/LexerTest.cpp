@@ -237,6 +237,9 @@ TEST(Lexer, DescribeTokens) {
   EXPECT_EQ(describe(l->tokens[4]), "string \"s\"");
   Token eof;
   EXPECT_EQ(describe(eof), "end of file");
+  auto m = lex("\"two\nlines\" \"a very long description string indeed\"");
+  EXPECT_EQ(describe(m->tokens[0]), "string \"two\\nlines\"");
+  EXPECT_EQ(describe(m->tokens[1]), "string \"a very long description...");
 }
 
 }  // namespace
