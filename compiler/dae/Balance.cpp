@@ -69,7 +69,10 @@ bool checkBalance(const Dae& dae, sym::Context& ctx, DiagnosticEngine& diags) {
       if (m.matchOfEquation[e] == structural::kUnmatched) extra.push_back(e);
     auto& d = diags.error(dae.range, neq > nvar ? "E0502" : "E0503",
                           (neq > nvar ? "too many equations: " : "structurally singular system: ") + counts +
-                              "; the equations involving " + joinNames(dae, dm.overVariables) + " over-determine them",
+                              (dm.overVariables.empty()
+                                   ? "; " + std::to_string(extra.size()) + " equation(s) determine no unknown"
+                                   : "; the equations involving " + joinNames(dae, dm.overVariables) +
+                                         " over-determine them"),
                           "remove the redundant equation(s), or turn a parameter they fix into an unknown");
     for (int e : dm.overEquations)
       if (d.notes.size() < 12)

@@ -141,7 +141,7 @@ class Deriver {
                    "add its kinetic energy in the mechanics section, or declare it as a plain 'Real'");
       return;
     }
-    bool inertial = !lagrangian_.termsOf(v).empty() || !dissipation_.termsOf(v).empty();
+    bool inertial = !lagrangian_.termsOf(v).empty();
     out_.rows.push_back({q, residual, p, inertial});
   }
 

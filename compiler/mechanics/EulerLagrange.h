@@ -22,8 +22,8 @@ struct CoordinateRow {
   int coordinate = -1;         ///< flat variable index of q
   sym::Expr residual = nullptr;  ///< = 0
   sym::Expr momentum = nullptr;  ///< generalized momentum p = ∂L/∂v
-  /// False when neither T nor D contains der(q): the row is then an algebraic equation for q
-  /// (a massless node, spec §7) and q has no velocity state.
+  /// False when T does not contain der(q) (no inertia): the row then determines der(q) (if D or a
+  /// force contains it: a first-order coordinate) or q itself (a massless node, spec §7).
   bool inertial = true;
 };
 

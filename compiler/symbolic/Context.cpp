@@ -58,7 +58,7 @@ void computeDerived(Node& n) {
 }
 
 bool shallowEqual(const Node& a, const Node& b) {
-  return a.hash == b.hash && a.kind == b.kind && a.symbolId == b.symbolId &&
+  return a.kind == b.kind && a.symbolId == b.symbolId &&
          numberBits(a.value) == numberBits(b.value) && a.args == b.args && a.exps == b.exps &&
          a.coefs.size() == b.coefs.size() &&
          std::equal(a.coefs.begin(), a.coefs.end(), b.coefs.begin(),
@@ -74,23 +74,23 @@ Expr Context::Impl::intern(Node&& n) {
   if ((tableUsed + 1) * 2 > table.size()) growTable();
   size_t mask = table.size() - 1;
   size_t i = n.hash & mask;
-  for (; table[i]; i = (i + 1) & mask)
-    if (shallowEqual(*table[i], n)) return table[i];
+  for (; table[i].node; i = (i + 1) & mask)  // the stored hash spares loading non-matching nodes
+    if (table[i].hash == n.hash && shallowEqual(*table[i].node, n)) return table[i].node;
   nodes.push_back(std::move(n));
-  table[i] = &nodes.back();
+  table[i] = {nodes.back().hash, &nodes.back()};
   ++tableUsed;
-  return table[i];
+  return table[i].node;
 }
 
 void Context::Impl::growTable() {
-  std::vector<Expr> old(table.empty() ? 1024 : table.size() * 2, nullptr);
+  std::vector<TableSlot> old(table.empty() ? 1024 : table.size() * 2);
   old.swap(table);
   size_t mask = table.size() - 1;
-  for (Expr e : old) {
-    if (!e) continue;
-    size_t i = e->hash & mask;
-    while (table[i]) i = (i + 1) & mask;
-    table[i] = e;
+  for (const TableSlot& s : old) {
+    if (!s.node) continue;
+    size_t i = s.hash & mask;
+    while (table[i].node) i = (i + 1) & mask;
+    table[i] = s;
   }
 }
 

@@ -91,7 +91,11 @@ struct Context::Impl {
 
   Context& ctx;
   std::deque<Node> nodes;           ///< arena; addresses are stable
-  std::vector<Expr> table;          ///< open-addressing intern table (power-of-two size)
+  struct TableSlot {
+    uint64_t hash = 0;
+    Expr node = nullptr;
+  };
+  std::vector<TableSlot> table;     ///< open-addressing intern table (power-of-two size)
   size_t tableUsed = 0;
   std::unordered_map<std::string, Expr> symbolsByName;
   std::deque<std::string> symbolNames;  ///< by symbolId (deque keeps references stable)
