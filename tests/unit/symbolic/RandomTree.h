@@ -6,6 +6,7 @@
 // where a finite-difference stencil would straddle a kink.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <random>
