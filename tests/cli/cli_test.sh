@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Command-line behaviour of qdot: exit codes (0 ok, 1 model errors, 2 bad command line), output
+# of the README's first command, JSON that parses. Usage: cli_test.sh QDOT_BINARY SOURCE_DIR
+set -u
+qdot=$1
+src=$2
+fail=0
+pass=0
+check() {  # check NAME EXPECTED_EXIT COMMAND...
+  local name=$1 want=$2
+  shift 2
+  "$@" >/tmp/qdot_cli_out.$$ 2>&1
+  local got=$?
+  if [ "$got" -eq "$want" ]; then pass=$((pass + 1)); else
+    echo "FAIL $name: exit $got, expected $want"; sed 's/^/    /' /tmp/qdot_cli_out.$$; fail=$((fail + 1)); fi
+}
+contains() {  # contains NAME TEXT COMMAND...
+  local name=$1 text=$2
+  shift 2
+  if "$@" 2>&1 | grep -qF -- "$text"; then pass=$((pass + 1)); else echo "FAIL $name: no '$text'"; fail=$((fail + 1)); fi
+}
+
+check version 0 "$qdot" --version
+check help 0 "$qdot" --help
+check no-arguments 2 "$qdot"
+check unknown-command 2 "$qdot" frobnicate
+check missing-file 2 "$qdot" check "$src/does/not/exist.qd"
+check unknown-option 2 "$qdot" equations "$src/examples/textbook/utube.qd" --bogus
+check model-ok 0 "$qdot" check "$src/examples/textbook/utube.qd"
+check model-error 1 "$qdot" check "$src/tests/diagnostics/unknown_name.qd"
+check unknown-model 1 "$qdot" equations "$src/examples/textbook/utube.qd" --model Nope
+check emit-ast 0 "$qdot" check "$src/examples/textbook/utube.qd" --emit=ast
+# The README's first command: the U-tube's equation of motion, rho*A*(l ẍ + 2 g x) = 0 (checked
+# numerically against the textbook in TextbookExamplesTest; here: that it is what gets printed).
+contains utube-equation "x:  rho*A*l*der(der(x)) + 2*rho*A*g*x = 0" "$qdot" equations "$src/examples/textbook/utube.qd"
+contains utube-integral "jacobi (Jacobi integral, conserved)" "$qdot" equations "$src/examples/textbook/utube.qd"
+contains caret "^~~" "$qdot" check "$src/tests/diagnostics/unknown_name.qd"
+contains location "unknown_name.qd:6:17: error[E0202]: unknown name 'mas'" "$qdot" check "$src/tests/diagnostics/unknown_name.qd"
+for f in "$src"/examples/*/*.qd; do
+  check "json-$(basename "$f")" 0 sh -c "'$qdot' equations '$f' --json | python3 -m json.tool"
+done
+rm -f /tmp/qdot_cli_out.$$
+echo "cli: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]
