@@ -25,17 +25,17 @@ const UnaryMath kUnaryMath[] = {
 
 }  // namespace
 
+// d/dt with one memo for the whole model. A symbol's rate is asked once, when a derivative first
+// reaches it: time → 1, parameters (and non-variables) → 0, any other variable → its der() variable,
+// created on demand (an error at `where` if it cannot have one; it is then asked again next time).
 Expr Flattener::timeDerivative(Expr e, SourceRange where) {
-  std::vector<Expr> terms;
-  for (Expr s : ctx_.freeSymbols(e)) {
+  timeDerivative_.setRateFunction([this, &where](Expr s) {
     int var = out_.variableOf(s);
-    if (var < 0) continue;
-    VarRole role = out_.variables[var].role;
-    if (role == VarRole::Parameter) continue;
-    Expr rate = role == VarRole::Time ? ctx_.one() : out_.variables[derivativeVariable(var, where)].symbol;
-    terms.push_back(ctx_.mul(ctx_.diff(e, s), rate));
-  }
-  return ctx_.add(terms);
+    if (var < 0 || out_.variables[var].role == VarRole::Parameter) return ctx_.zero();
+    if (out_.variables[var].role == VarRole::Time) return ctx_.one();
+    return out_.variables[derivativeVariable(var, where)].symbol;
+  });
+  return timeDerivative_(e);
 }
 
 Value Flattener::lowerCall(const CallExpr& e) {

@@ -50,6 +50,7 @@ class Flattener {
   FlattenLimits limits_;
   FlatModel out_;
   size_t scalars_ = 0;
+  sym::DirectionalDerivative timeDerivative_{ctx_};  ///< der(): memo shared by all calls
 
   std::unordered_map<const ast::Declaration*, Value> declValues_;
   std::unordered_set<const ast::Declaration*> inProgress_;

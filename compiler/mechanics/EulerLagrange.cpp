@@ -48,6 +48,7 @@ class Deriver {
   TermIndex lagrangian_, dissipation_;
   std::unordered_map<int, std::vector<Expr>> forces_;
   EquationsOfMotion out_;
+  std::optional<sym::DirectionalDerivative> timeDerivative_;  ///< d/dt, set up on first use
 
   Expr total(const std::vector<flat::Term>& terms) {
     std::vector<Expr> v;
@@ -109,18 +110,19 @@ class Deriver {
     return ctx_.add(parts);
   }
 
-  // d/dt of an expression in coordinates, velocities, parameters and time.
+  // d/dt of an expression in coordinates, velocities, parameters and time: along q → v, v → a and
+  // time → 1 (everything else is constant). One derivative object for all rows, so subexpressions
+  // the momenta share (the velocities of every mass) are differentiated once.
   Expr timeDerivative(Expr e) {
-    std::vector<Expr> terms;
-    for (Expr s : ctx_.freeSymbols(e)) {
-      int var = m_.variableOf(s);
-      if (var < 0) continue;
-      const flat::Variable& v = m_.variables[var];
-      if (v.role == VarRole::Time) terms.push_back(ctx_.diff(e, s));
-      else if (v.role == VarRole::Coordinate || v.role == VarRole::Velocity)
-        terms.push_back(ctx_.mul(ctx_.diff(e, s), m_.variables[v.derivative].symbol));
+    if (!timeDerivative_) {
+      timeDerivative_.emplace(ctx_);
+      for (const flat::Variable& v : m_.variables) {
+        if (v.role == VarRole::Time) timeDerivative_->setRate(v.symbol, ctx_.one());
+        else if ((v.role == VarRole::Coordinate || v.role == VarRole::Velocity) && v.derivative >= 0)
+          timeDerivative_->setRate(v.symbol, m_.variables[v.derivative].symbol);
+      }
     }
-    return ctx_.add(terms);
+    return (*timeDerivative_)(e);
   }
 
   void derive(int q) {

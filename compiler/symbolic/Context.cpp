@@ -1,6 +1,13 @@
 // The Context: node arena, hash-consing (intern) table, constants and symbols.
 // Every node is created through Impl::intern, which computes the structural hash, the symbol mask
-// and the depth from the (already built) children and returns the existing node when one is equal.
+// and the depth from the (already built) children and returns the existing node when one is equal;
+// only a new node is copied into the arena (node and operands), so a lookup that hits allocates nothing.
+#include <algorithm>
+#include <cstddef>
+#include <functional>
+#include <new>
+#include <type_traits>
+#include <utility>
 #include <stdexcept>
 
 #include "symbolic/ContextImpl.h"
@@ -57,53 +64,75 @@ void computeDerived(Node& n) {
   n.depth = depth;
 }
 
+template <class T>
+bool sameElements(std::span<const T> a, std::span<const T> b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+// Numbers compare by bit pattern (they are normalized, so -0 and NaN payloads cannot differ).
 bool shallowEqual(const Node& a, const Node& b) {
-  return a.kind == b.kind && a.symbolId == b.symbolId &&
-         numberBits(a.value) == numberBits(b.value) && a.args == b.args && a.exps == b.exps &&
-         a.coefs.size() == b.coefs.size() &&
-         std::equal(a.coefs.begin(), a.coefs.end(), b.coefs.begin(),
-                    [](double x, double y) { return numberBits(x) == numberBits(y); });
+  return a.kind == b.kind && a.symbolId == b.symbolId && numberBits(a.value) == numberBits(b.value) &&
+         sameElements(a.args, b.args) && sameElements(a.exps, b.exps) && sameElements(a.coefs, b.coefs);
 }
 
 }  // namespace
 
-Expr Context::Impl::intern(Node&& n) {
-  n.value = normalizeNumber(n.value);
-  for (double& c : n.coefs) c = normalizeNumber(c);
-  computeDerived(n);
-  if ((tableUsed + 1) * 2 > table.size()) growTable();
-  size_t mask = table.size() - 1;
-  size_t i = n.hash & mask;
+Expr Context::Impl::intern(Node& key) {
+  key.value = normalizeNumber(key.value);
+  computeDerived(key);
+  if ((nodeCount + 1) * 2 > tableSize) growTable();
+  size_t mask = tableSize - 1;
+  size_t i = key.hash & mask;
   for (; table[i].node; i = (i + 1) & mask)  // the stored hash spares loading non-matching nodes
-    if (table[i].hash == n.hash && shallowEqual(*table[i].node, n)) return table[i].node;
-  nodes.push_back(std::move(n));
-  table[i] = {nodes.back().hash, &nodes.back()};
-  ++tableUsed;
+    if (table[i].hash == key.hash && shallowEqual(*table[i].node, key)) return table[i].node;
+  table[i] = {key.hash, store(key)};
   return table[i].node;
 }
 
+// Copies the node into the arena with its operands right behind it (one allocation, one or two
+// cache lines for a small node): children in one array (args, then exps), then the coefficients.
+Expr Context::Impl::store(const Node& key) {
+  size_t nArgs = key.args.size(), nKids = nArgs + key.exps.size(), nCoefs = key.coefs.size();
+  static_assert(std::is_trivially_destructible_v<Node> && sizeof(Node) % alignof(Expr) == 0 &&
+                alignof(Expr) == alignof(double) && alignof(Node) >= alignof(Expr));
+  void* bytes = arena.allocateBytes(sizeof(Node) + nKids * sizeof(Expr) + nCoefs * sizeof(double), alignof(Node));
+  Node* n = new (bytes) Node(key);
+  auto* kids = reinterpret_cast<Expr*>(static_cast<std::byte*>(bytes) + sizeof(Node));
+  auto* coefs = reinterpret_cast<double*>(kids + nKids);
+  std::copy(key.args.begin(), key.args.end(), kids);
+  std::copy(key.exps.begin(), key.exps.end(), kids + nArgs);
+  std::copy(key.coefs.begin(), key.coefs.end(), coefs);
+  n->args = {kids, nArgs};
+  n->exps = {kids + nArgs, key.exps.size()};
+  n->coefs = {coefs, nCoefs};
+  ++nodeCount;
+  return n;
+}
+
 void Context::Impl::growTable() {
-  std::vector<TableSlot> old(table.empty() ? 1024 : table.size() * 2);
-  old.swap(table);
-  size_t mask = table.size() - 1;
-  for (const TableSlot& s : old) {
-    if (!s.node) continue;
-    size_t i = s.hash & mask;
+  size_t oldSize = tableSize;
+  tableSize = tableSize ? 2 * tableSize : 1024;
+  auto old = std::exchange(table, allocateLarge<TableSlot>(tableSize));
+  std::fill_n(table.get(), tableSize, TableSlot{});
+  size_t mask = tableSize - 1;
+  for (size_t k = 0; k < oldSize; ++k) {
+    if (!old[k].node) continue;
+    size_t i = old[k].hash & mask;
     while (table[i].node) i = (i + 1) & mask;
-    table[i] = s;
+    table[i] = old[k];
   }
 }
 
-Expr Context::Impl::makeMul(double coef, std::vector<Expr>&& bases, std::vector<Expr>&& exps) {
+Expr Context::Impl::makeMul(double coef, std::span<const Expr> bases, std::span<const Expr> exps) {
   if (coef == 0.0) return ctx.zero();
   if (bases.empty()) return ctx.constant(coef);
   if (bases.size() == 1 && coef == 1.0) return exps[0]->isOne() ? bases[0] : ctx.pow(bases[0], exps[0]);
   Node n{};
   n.kind = Kind::Mul;
   n.value = coef;
-  n.args = std::move(bases);
-  n.exps = std::move(exps);
-  return intern(std::move(n));
+  n.args = bases;
+  n.exps = exps;
+  return intern(n);
 }
 
 Context::Context() : impl_(std::make_unique<Impl>(*this)) {
@@ -113,28 +142,64 @@ Context::Context() : impl_(std::make_unique<Impl>(*this)) {
 
 Context::~Context() = default;
 
+// Numbers recur constantly (0, 1, 2, -1, 0.5, model parameters): a direct-mapped cache in front
+// of the intern table answers most of them without hashing the node.
 Expr Context::constant(double v) {
+  v = normalizeNumber(v);
+  uint64_t bits = numberBits(v);
+  auto& slot = impl_->recentConstants[(bits * 0x9E3779B97F4A7C15ull) >> 54];
+  if (slot.node && slot.bits == bits) return slot.node;
   Node n{};
   n.kind = Kind::Constant;
   n.value = v;
-  return impl_->intern(std::move(n));
+  slot = {bits, impl_->intern(n)};
+  return slot.node;
 }
 
 Expr Context::symbol(std::string_view name) {
-  if (Expr s = findSymbol(name)) return s;
+  uint64_t hash = std::hash<std::string_view>{}(name);
+  if (Expr s = impl_->findSymbol(name, hash)) return s;
   Node n{};
   n.kind = Kind::Symbol;
   n.symbolId = static_cast<uint32_t>(impl_->symbols.size());
-  Expr s = impl_->intern(std::move(n));
+  Expr s = impl_->intern(n);
   impl_->symbols.push_back(s);
   impl_->symbolNames.emplace_back(name);
-  impl_->symbolsByName.emplace(std::string(name), s);
+  impl_->addSymbolName(hash, s->symbolId);
   return s;
 }
 
 Expr Context::findSymbol(std::string_view name) const {
-  auto it = impl_->symbolsByName.find(std::string(name));
-  return it == impl_->symbolsByName.end() ? nullptr : it->second;
+  return impl_->findSymbol(name, std::hash<std::string_view>{}(name));
+}
+
+Expr Context::Impl::findSymbol(std::string_view name, uint64_t hash) const {
+  if (symbolsByName.empty()) return nullptr;
+  size_t mask = symbolsByName.size() - 1;
+  for (size_t i = hash & mask; symbolsByName[i].used; i = (i + 1) & mask) {
+    const NameSlot& slot = symbolsByName[i];
+    if (slot.hash == hash && symbolNames[slot.symbolId] == name) return symbols[slot.symbolId];
+  }
+  return nullptr;
+}
+
+void Context::Impl::addSymbolName(uint64_t hash, uint32_t symbolId) {
+  if ((symbols.size() + 1) * 2 > symbolsByName.size()) growSymbolsByName();
+  size_t mask = symbolsByName.size() - 1, i = hash & mask;
+  while (symbolsByName[i].used) i = (i + 1) & mask;
+  symbolsByName[i] = {hash, symbolId, true};
+}
+
+void Context::Impl::growSymbolsByName() {
+  std::vector<NameSlot> old(symbolsByName.empty() ? 64 : symbolsByName.size() * 2);
+  old.swap(symbolsByName);
+  size_t mask = symbolsByName.size() - 1;
+  for (const NameSlot& s : old) {
+    if (!s.used) continue;
+    size_t i = s.hash & mask;
+    while (symbolsByName[i].used) i = (i + 1) & mask;
+    symbolsByName[i] = s;
+  }
 }
 
 const std::string& Context::symbolName(Expr s) const {
@@ -145,6 +210,6 @@ const std::string& Context::symbolName(Expr s) const {
 
 size_t Context::symbolCount() const { return impl_->symbols.size(); }
 
-size_t Context::nodeCount() const { return impl_->nodes.size(); }
+size_t Context::nodeCount() const { return impl_->nodeCount; }
 
 }  // namespace qdot::sym

@@ -1,6 +1,7 @@
 // Internals of the symbolic Context shared by the rule files (not a public header).
 // Holds the node arena and intern table, symbol names, derivative memos, the Add/Mul builders that
-// produce canonical forms, and small helpers for children access and iterative traversal.
+// produce canonical forms (on inline buffers: no heap for small operand lists), and small helpers
+// for children access and iterative traversal.
 #pragma once
 
 #include <cmath>
@@ -9,20 +10,20 @@
 #include <limits>
 #include <span>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
+#include "symbolic/Arena.h"
 #include "symbolic/Expr.h"
 #include "symbolic/NodeMap.h"
+#include "symbolic/SmallVec.h"
 
 namespace qdot::sym {
 
-// --- children: args followed by exps -------------------------------------------------------------
+// --- children: args followed by exps (one array in the arena) -------------------------------------
 
 inline size_t childCount(Expr n) { return n->args.size() + n->exps.size(); }
-inline Expr child(Expr n, size_t i) {
-  return i < n->args.size() ? n->args[i] : n->exps[i - n->args.size()];
-}
+inline std::span<const Expr> children(Expr n) { return {n->args.data(), childCount(n)}; }
+inline Expr child(Expr n, size_t i) { return n->args.data()[i]; }
 
 /// Arity from ExprKinds.def (-1 = n-ary).
 int kindArity(Kind k);
@@ -90,28 +91,46 @@ struct Context::Impl {
   explicit Impl(Context& c) : ctx(c) {}
 
   Context& ctx;
-  std::deque<Node> nodes;           ///< arena; addresses are stable
-  struct TableSlot {
-    uint64_t hash = 0;
+  Arena arena;                      ///< nodes and their operand arrays
+  size_t nodeCount = 0;
+  struct TableSlot {  // trivial, so a new table is not touched before it is advised
+    uint64_t hash;
+    Expr node;
+  };
+  std::unique_ptr<TableSlot[]> table;  ///< open-addressing intern table (power-of-two size)
+  size_t tableSize = 0;
+  struct ConstantSlot {
+    uint64_t bits = 0;
     Expr node = nullptr;
   };
-  std::vector<TableSlot> table;     ///< open-addressing intern table (power-of-two size)
-  size_t tableUsed = 0;
-  std::unordered_map<std::string, Expr> symbolsByName;
+  std::vector<ConstantSlot> recentConstants = std::vector<ConstantSlot>(1024);  ///< direct-mapped cache
   std::deque<std::string> symbolNames;  ///< by symbolId (deque keeps references stable)
   std::vector<Expr> symbols;            ///< by symbolId
+  struct NameSlot {
+    uint64_t hash = 0;
+    uint32_t symbolId = 0;
+    bool used = false;
+  };
+  std::vector<NameSlot> symbolsByName;  ///< open addressing over the name hashes
   std::vector<NodeMap<Expr>> diffMemo;  ///< by symbolId: node -> derivative
 
-  /// Returns the unique node structurally equal to n (fills hash, mask, depth), creating it if new.
-  Expr intern(Node&& n);
+  /// Returns the unique node structurally equal to `key`, creating it if new (then its operands
+  /// are copied into the arena, so the key's spans may point to temporary storage). Fills the key's
+  /// hash, mask and depth and normalizes its value; Add coefficients must already be normalized.
+  Expr intern(Node& key);
   /// A Mul node from already canonical, sorted, merged (base, exponent) pairs; applies the
   /// single-factor rules (no factor -> constant, one factor with coef 1 -> base or Pow).
-  Expr makeMul(double coef, std::vector<Expr>&& bases, std::vector<Expr>&& exps);
+  Expr makeMul(double coef, std::span<const Expr> bases, std::span<const Expr> exps);
   /// Rebuilds n with new children (args then exps), re-simplifying. Returns n if unchanged.
   Expr rebuild(Expr n, std::span<const Expr> kids);
+  /// The symbol with this name, or nullptr.
+  Expr findSymbol(std::string_view name, uint64_t hash) const;
+  void addSymbolName(uint64_t hash, uint32_t symbolId);
 
  private:
+  Expr store(const Node& key);
   void growTable();
+  void growSymbolsByName();
 };
 
 /// Accumulates constant + Σ coef·term and builds the canonical Add (flattening nested sums and
@@ -121,12 +140,21 @@ class AddBuilder {
   explicit AddBuilder(Context& ctx) : ctx_(ctx) {}
   void add(double coef, Expr e);
   void addConstant(double v) { constants_.push_back(v); }
+  /// Room for n more terms.
+  void reserve(size_t n) { terms_.reserve(terms_.size() + n); }
   Expr build();
 
+  struct Term {
+    Expr e;
+    double coef;
+  };
+
  private:
+  void addTerms(double coef, Expr sum);
+  void sortTerms();
   Context& ctx_;
-  std::vector<double> constants_;  // summed in sorted order: the result is permutation invariant
-  std::vector<std::pair<Expr, double>> terms_;
+  SmallVec<double, 4> constants_;  // summed in sorted order: the result is permutation invariant
+  SmallVec<Term, 8> terms_;
 };
 
 /// Accumulates coef · Π base^exp and builds the canonical Mul (collecting equal bases).
@@ -140,9 +168,13 @@ class MulBuilder {
   /// Multiplies by b^e.
   void power(Expr b, Expr e);
   /// Multiplies by a (base, exponent) pair taken from a canonical Mul, as is.
-  void pair(Expr b, Expr e) { pairs_.emplace_back(b, e); }
+  void pair(Expr b, Expr e) { pairs_.push_back({b, e}); }
   void scale(double c) { coefs_.push_back(c); }
   Expr build();
+
+  struct Factor {
+    Expr base, exp;
+  };
 
  private:
   void mergeEqualBases();
@@ -150,8 +182,8 @@ class MulBuilder {
   bool redecompose();
   double coefficient();
   Context& ctx_;
-  std::vector<double> coefs_;  // multiplied in sorted order: the result is permutation invariant
-  std::vector<std::pair<Expr, Expr>> pairs_;
+  SmallVec<double, 4> coefs_;  // multiplied in sorted order: the result is permutation invariant
+  SmallVec<Factor, 8> pairs_;
 };
 
 }  // namespace qdot::sym

@@ -1,7 +1,8 @@
 // Symbolic differentiation: one rule per kind (the switch in `rule` has no default, so a new kind
-// without a rule triggers -Wswitch) and Context::diff, which walks the DAG iteratively in post-order,
-// memoising ∂n/∂s per (node, symbol) in the Context and skipping nodes whose symbol mask lacks s.
-// The memo doubles as the visited set, so a call costs O(nodes not yet differentiated w.r.t. s).
+// without a rule triggers -Wswitch), applied along a Direction: the rate at which each symbol moves.
+// Context::diff is the direction {s -> 1}; DirectionalDerivative is any field {s -> rate(s)} (d/dt).
+// One iterative post-order walk serves both, memoising per node and skipping nodes whose symbol mask
+// misses every moving symbol; the memo doubles as the visited set, so a call costs O(new nodes).
 #include <stdexcept>
 
 #include "symbolic/ContextImpl.h"
@@ -10,16 +11,24 @@ namespace qdot::sym {
 
 namespace {
 
-// What a rule sees: the Context, the symbol, and the derivatives of the node's children.
+// What the derivative is taken along: rate(s) for every symbol; `mask` has the bits of every symbol
+// whose rate may be non-zero (all bits when rates are only known on demand).
+struct Direction {
+  uint64_t mask = 0;
+  virtual Expr rate(Expr symbol) = 0;
+
+ protected:
+  ~Direction() = default;
+};
+
+// What a rule sees: the Context, the direction, and the derivatives of the node's children.
 struct Diff {
   Context& ctx;
-  Expr s;
+  Direction& dir;
   NodeMap<Expr>& memo;
 
-  Expr d(Expr c) const {
-    if (!(c->symbolMask & symbolBit(s))) return ctx.zero();
-    return *memo.find(c);
-  }
+  bool mayMove(Expr c) const { return (c->symbolMask & dir.mask) != 0; }
+  Expr d(Expr c) const { return mayMove(c) ? *memo.find(c) : ctx.zero(); }
   Expr chain(Expr outer, Expr du) const { return du->isZero() ? du : ctx.mul(outer, du); }
   Expr square(Expr u) const { return ctx.pow(u, ctx.constant(2.0)); }
 };
@@ -43,26 +52,28 @@ Expr powRule(const Diff& D, Expr b, Expr e, Expr self) {
   }
   if (de->isZero()) return first;
   Expr bToE = self ? self : ctx.pow(b, e);
-  Expr second = ctx.mul(std::vector<Expr>{bToE, ctx.unary(Kind::Log, b), de});
+  Expr factors[] = {bToE, ctx.unary(Kind::Log, b), de};
+  Expr second = ctx.mul(factors);
   return ctx.add(first, second);
 }
 
 Expr dConstant(const Diff& D, Expr) { return D.ctx.zero(); }
-Expr dSymbol(const Diff& D, Expr n) { return n == D.s ? D.ctx.one() : D.ctx.zero(); }
+Expr dSymbol(const Diff& D, Expr n) { return D.dir.rate(n); }
 
 Expr dAdd(const Diff& D, Expr n) {
   AddBuilder sum(D.ctx);
-  for (size_t i = 0; i < n->args.size(); ++i) sum.add(n->coefs[i], D.d(n->args[i]));
+  for (size_t i = 0; i < n->args.size(); ++i)
+    if (Expr d = D.d(n->args[i]); !d->isZero()) sum.add(n->coefs[i], d);
   return sum.build();
 }
 
-// Product rule over the factors that depend on s: Σ_i (Π_{j≠i} f_j) * d(f_i).
+// Product rule over the factors that may move: Σ_i (Π_{j≠i} f_j) * d(f_i).
 Expr dMul(const Diff& D, Expr n) {
   AddBuilder sum(D.ctx);
   size_t m = n->args.size();
   for (size_t i = 0; i < m; ++i) {
     Expr b = n->args[i], e = n->exps[i];
-    if (!((b->symbolMask | e->symbolMask) & symbolBit(D.s))) continue;
+    if (!D.mayMove(b) && !D.mayMove(e)) continue;
     Expr dFactor = powRule(D, b, e, nullptr);
     if (dFactor->isZero()) continue;  // the mask only said "maybe"
     MulBuilder term(D.ctx, n->value);
@@ -158,33 +169,99 @@ Expr rule(const Diff& D, Expr n) {
   throw std::logic_error("diff: corrupt node kind");
 }
 
-}  // namespace
-
-Expr Context::diff(Expr e, Expr s) {
-  if (!s || !s->isSymbol()) throw std::invalid_argument("diff: not a symbol");
-  uint64_t bit = symbolBit(s);
-  if (!(e->symbolMask & bit)) return zero_;
-  auto& memos = impl_->diffMemo;
-  if (memos.size() <= s->symbolId) memos.resize(s->symbolId + 1);
-  NodeMap<Expr>& memo = memos[s->symbolId];
+// The derivative of e along dir: post-order over the nodes that may move and have no memo yet.
+// A child is finished (memoised) before its next sibling is looked at. If dir.rate throws, only
+// finished nodes are in the memo, so it stays valid.
+Expr differentiate(Context& ctx, Direction& dir, NodeMap<Expr>& memo, Expr e) {
+  Diff D{ctx, dir, memo};
+  if (!D.mayMove(e)) return ctx.zero();
   if (Expr* known = memo.find(e)) return *known;
-
-  // Depth-first post-order over the nodes that may contain s and have no memo yet. The memo is the
-  // visited set: a child is finished (memoised) before its next sibling is looked at.
-  Diff D{*this, s, memo};
-  std::vector<std::pair<Expr, uint32_t>> stack{{e, 0}};
+  struct Frame {
+    Expr node;
+    uint32_t next;  // next child to look at
+  };
+  SmallVec<Frame, 16> stack;
+  stack.push_back({e, 0});
   while (!stack.empty()) {
-    auto& [n, next] = stack.back();
-    if (next < childCount(n)) {
-      Expr c = child(n, next++);
-      if ((c->symbolMask & bit) && !memo.find(c)) stack.push_back({c, 0});
+    Frame& f = stack.back();
+    if (f.next < childCount(f.node)) {
+      Expr c = child(f.node, f.next++);
+      if (D.mayMove(c) && !memo.find(c)) stack.push_back({c, 0});
     } else {
-      Expr node = n;
+      Expr node = f.node;
       stack.pop_back();
       memo.insert(node, rule(D, node));
     }
   }
   return *memo.find(e);
 }
+
+// ∂/∂s: rate 1 for s, 0 for every other symbol.
+struct Partial final : Direction {
+  Partial(Context& c, Expr s) : ctx(c), wrt(s) { mask = symbolBit(s); }
+  Expr rate(Expr symbol) override { return symbol == wrt ? ctx.one() : ctx.zero(); }
+  Context& ctx;
+  Expr wrt;
+};
+
+}  // namespace
+
+Expr Context::diff(Expr e, Expr s) {
+  if (!s || !s->isSymbol()) throw std::invalid_argument("diff: not a symbol");
+  auto& memos = impl_->diffMemo;
+  if (memos.size() <= s->symbolId) memos.resize(s->symbolId + 1);
+  Partial along(*this, s);
+  return differentiate(*this, along, memos[s->symbolId], e);
+}
+
+// --- DirectionalDerivative -------------------------------------------------------------------------
+
+// Explicit rates (mask: their bits), plus the rate function's answers, cached as rates.
+struct DirectionalDerivative::Impl final : Direction {
+  explicit Impl(Context& c) : ctx(c) {}
+  Expr rate(Expr symbol) override {
+    if (Expr* known = rates.find(symbol)) return *known;
+    if (!rateOf) return ctx.zero();
+    Expr r = rateOf(symbol);
+    if (!r) throw std::invalid_argument("DirectionalDerivative: the rate function returned no expression");
+    rates.insert(symbol, r);
+    return r;
+  }
+
+  Context& ctx;
+  NodeMap<Expr> rates;
+  std::function<Expr(Expr)> rateOf;
+  NodeMap<Expr> memo;  ///< node -> derivative along the current rates
+};
+
+DirectionalDerivative::DirectionalDerivative(Context& ctx) : impl_(std::make_unique<Impl>(ctx)) {}
+DirectionalDerivative::~DirectionalDerivative() = default;
+DirectionalDerivative::DirectionalDerivative(DirectionalDerivative&&) noexcept = default;
+
+// The memo is kept unless a memoised node may contain the symbol: it was reached (it is memoised
+// itself), or its bit is new to the mask (subtrees with that bit were skipped as constant).
+void DirectionalDerivative::setRate(Expr symbol, Expr rate) {
+  if (!symbol || !symbol->isSymbol()) throw std::invalid_argument("setRate: not a symbol");
+  if (!rate) throw std::invalid_argument("setRate: no rate expression");
+  Impl& d = *impl_;
+  Expr* old = d.rates.find(symbol);
+  if (old ? *old == rate : rate->isZero() && !d.rateOf) return;
+  if (d.memo.find(symbol) || !(d.mask & symbolBit(symbol))) d.memo.clear();
+  d.mask |= symbolBit(symbol);
+  if (old) *old = rate;
+  else d.rates.insert(symbol, rate);
+}
+
+// The first function widens the mask to every symbol (skipped subtrees may now move: drop the
+// memo); replacing it later keeps the memo, since every symbol reached so far has a cached rate.
+void DirectionalDerivative::setRateFunction(std::function<Expr(Expr)> rateOf) {
+  Impl& d = *impl_;
+  d.rateOf = std::move(rateOf);
+  if (!d.rateOf || d.mask == ~uint64_t{0}) return;
+  d.memo.clear();
+  d.mask = ~uint64_t{0};
+}
+
+Expr DirectionalDerivative::operator()(Expr e) { return differentiate(impl_->ctx, *impl_, impl_->memo, e); }
 
 }  // namespace qdot::sym

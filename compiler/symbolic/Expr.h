@@ -23,7 +23,8 @@
 // Costs the later stages rely on: building a node is O(arity) amortised (O(n log n) for an n-ary
 // Add/Mul); diff(e, s) is memoised per (node, symbol) and returns zero in O(1) for a node whose
 // symbol mask shows it cannot contain s, so differentiating a sum of N terms is O(N) and repeated
-// derivatives share nodes.
+// derivatives share nodes. A DirectionalDerivative (d/dt) is one forward pass per new node, with
+// its memo shared by all its calls.
 #pragma once
 
 #include <cstddef>
@@ -55,16 +56,18 @@ using Expr = const Node*;
 ///  Add: value = constant term; args = terms; coefs = their numeric coefficients.
 ///  Mul: value = numeric coefficient; args = bases, exps = exponents (Exprs, often constants).
 ///  every other kind: args in order (Select: cond, then, else).
+/// The operand spans point into the Context's arena (a Mul's exps directly follow its args) and
+/// live as long as the Context; nodes are trivially destructible.
 struct Node {
   Kind kind;
   uint32_t symbolId = 0;
+  uint32_t depth = 0;       ///< longest path to a leaf (leaves 0)
   uint64_t hash = 0;
   uint64_t symbolMask = 0;  ///< bit (id % 64) set for every symbol below; 0 => constant expression
-  uint32_t depth = 0;       ///< longest path to a leaf (leaves 0)
   double value = 0;
-  std::vector<Expr> args;
-  std::vector<double> coefs;  ///< Add only
-  std::vector<Expr> exps;     ///< Mul only
+  std::span<const Expr> args;
+  std::span<const double> coefs;  ///< Add only
+  std::span<const Expr> exps;     ///< Mul only
 
   bool isConstant() const { return kind == Kind::Constant; }
   bool isSymbol() const { return kind == Kind::Symbol; }
@@ -134,6 +137,39 @@ class Context {
  private:
   std::unique_ptr<Impl> impl_;
   Expr zero_, one_;
+};
+
+// --- directional derivative --------------------------------------------------------------------
+
+/// The derivative along a vector field, d/dt = Σ_s rate(s) · ∂/∂s (symbols without a rate have
+/// rate 0), computed forward in one pass with the same per-kind rules as Context::diff (which is
+/// the field {s -> 1}). The memo lives in the object, so subexpressions shared between calls are
+/// differentiated once: a call costs O(nodes of e not yet differentiated), a repeated call O(1).
+/// Subtrees whose symbol mask misses every rated symbol are zero in O(1).
+class DirectionalDerivative {
+ public:
+  explicit DirectionalDerivative(Context& ctx);
+  ~DirectionalDerivative();
+  DirectionalDerivative(DirectionalDerivative&&) noexcept;
+  DirectionalDerivative(const DirectionalDerivative&) = delete;
+  DirectionalDerivative& operator=(const DirectionalDerivative&) = delete;
+
+  /// Sets the rate of a symbol (any expression of the same Context). Best done before the first
+  /// call: changing a rate that earlier results may depend on drops the memo.
+  void setRate(Expr symbol, Expr rate);
+  /// Rates for symbols without one, asked once per symbol when a derivative first reaches it; the
+  /// answer is kept as its rate. Replacing the function keeps the rates (and memo) obtained so far,
+  /// so it may capture per-call context such as a source location. If it throws, the symbol stays
+  /// unrated and the call is abandoned with the memo still valid. With a function, no subtree can
+  /// be skipped by mask, so each call visits every symbol-bearing node it has not seen before.
+  void setRateFunction(std::function<Expr(Expr symbol)> rateOf);
+  /// d e / dt along the field.
+  Expr operator()(Expr e);
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
 };
 
 // --- evaluation --------------------------------------------------------------------------------

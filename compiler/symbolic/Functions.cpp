@@ -43,8 +43,8 @@ Expr Context::unary(Kind k, Expr x) {
   if (x->isConstant()) return constant(applyKind(k, x->value));
   Node n{};
   n.kind = k;
-  n.args = {x};
-  return impl_->intern(std::move(n));
+  n.args = {&x, 1};
+  return impl_->intern(n);
 }
 
 Expr Context::binary(Kind k, Expr a, Expr b) {
@@ -54,19 +54,21 @@ Expr Context::binary(Kind k, Expr a, Expr b) {
     if (Expr r = sameArgument(*this, k, a)) return r;
   if (Expr r = absorbingLogic(*this, k, a, b)) return r;
   if (isCommutative(k) && structuralCompare(b, a) < 0) std::swap(a, b);
+  Expr args[] = {a, b};
   Node n{};
   n.kind = k;
-  n.args = {a, b};
-  return impl_->intern(std::move(n));
+  n.args = args;
+  return impl_->intern(n);
 }
 
 Expr Context::select(Expr cond, Expr ifTrue, Expr ifFalse) {
   if (cond->isConstant()) return cond->value != 0.0 ? ifTrue : ifFalse;
   if (ifTrue == ifFalse) return ifTrue;
+  Expr args[] = {cond, ifTrue, ifFalse};
   Node n{};
   n.kind = Kind::Select;
-  n.args = {cond, ifTrue, ifFalse};
-  return impl_->intern(std::move(n));
+  n.args = args;
+  return impl_->intern(n);
 }
 
 }  // namespace qdot::sym

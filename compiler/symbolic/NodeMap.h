@@ -1,14 +1,17 @@
 // NodeMap<V>: a small open-addressing hash map keyed by node pointer, used for per-call memos
 // (evaluation tapes, substitute, CSE) and the per-symbol derivative memo. Linear probing,
-// power-of-two capacity, no erase; an empty map allocates nothing.
+// power-of-two capacity, no erase (only clear); an empty map allocates nothing.
+// NodeSet: the visited set of one traversal; a linear scan of an inline array while small.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <utility>
 #include <vector>
 
 #include "symbolic/Expr.h"
+#include "symbolic/SmallVec.h"
 
 namespace qdot::sym {
 
@@ -39,6 +42,11 @@ class NodeMap {
   }
 
   size_t size() const { return size_; }
+  /// Removes every entry (keeps the capacity).
+  void clear() {
+    std::fill(slots_.begin(), slots_.end(), std::pair<Expr, V>{});
+    size_ = 0;
+  }
 
  private:
   size_t mask() const { return slots_.size() - 1; }
@@ -58,6 +66,30 @@ class NodeMap {
 
   std::vector<std::pair<Expr, V>> slots_;
   size_t size_ = 0;
+};
+
+/// Visited nodes of one traversal. Most queries touch a handful of nodes: those stay in an inline
+/// array (no allocation, a scan of at most kSmall pointers); past that, a NodeMap takes over.
+class NodeSet {
+ public:
+  /// Adds n; true if it was not there yet.
+  bool insert(Expr n) {
+    if (small_.size() < kSmall) {
+      for (Expr s : small_)
+        if (s == n) return false;
+      small_.push_back(n);
+      return true;
+    }
+    if (small_.size() == kSmall && big_.size() == 0)
+      for (Expr s : small_) big_.insert(s, 1);
+    return big_.insert(n, 1).second;
+  }
+  size_t size() const { return big_.size() ? big_.size() : small_.size(); }
+
+ private:
+  static constexpr size_t kSmall = 32;
+  SmallVec<Expr, kSmall> small_;
+  NodeMap<char> big_;
 };
 
 }  // namespace qdot::sym

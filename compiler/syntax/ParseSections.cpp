@@ -93,6 +93,8 @@ ast::Equation Parser::parseForEquation() {
     bool closed = expectEnd(TokenKind::kw_for, kw.range);
     eq.range = rangeFrom(kw.range.begin);
     if (closed) expectSemi("after 'end for'");
+  } else {
+    brokenBlocks_.push_back(TokenKind::kw_for);
   }
   if (!eq.range.valid()) eq.range = rangeFrom(kw.range.begin);
   return eq;
@@ -124,6 +126,7 @@ ast::Equation Parser::parseConditionalEquation() {
   if (ok && isIf && accept(TokenKind::kw_else)) parseEquationList(eq.elseBranch, true);
   --branchDepth_;
   blockStack_.pop_back();
+  if (!ok) brokenBlocks_.push_back(kw.kind);
   bool closed = ok && expectEnd(kw.kind, kw.range);
   eq.range = rangeFrom(kw.range.begin);
   if (closed) expectSemi(std::string("after 'end ") + spelling(kw.kind) + "'");
@@ -261,6 +264,8 @@ ast::MechanicsStmt Parser::parseMechanicsFor() {
     bool closed = expectEnd(TokenKind::kw_for, kw.range);
     s.range = rangeFrom(kw.range.begin);
     if (closed) expectSemi("after 'end for'");
+  } else {
+    brokenBlocks_.push_back(TokenKind::kw_for);
   }
   if (!s.range.valid()) s.range = rangeFrom(kw.range.begin);
   return s;

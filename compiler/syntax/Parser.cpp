@@ -4,6 +4,7 @@
 #include "syntax/ParserImpl.h"
 
 #include <algorithm>
+#include <iterator>
 #include <utility>
 
 namespace qdot::syntax {
@@ -128,10 +129,12 @@ bool Parser::atStatementListEnd(bool nested) {
   }
 }
 
-/// Modelica words this language does not have: `algorithm`, `protected`, `public` (sections) and
-/// `partial` (before a class keyword). They are identifiers, so only their position tells.
+/// Modelica words this language does not have: `algorithm`, `initial algorithm`, `protected`,
+/// `public` (sections) and `partial` (before a class keyword). They are identifiers, so only their
+/// position tells.
 bool Parser::atUnsupportedWord() {
   const Token& t = tok();
+  if (t.is(TokenKind::kw_initial)) return peek(1).isWord("algorithm");
   if (t.isNot(TokenKind::identifier)) return false;
   TokenKind next = peek(1).kind;
   if (t.isWord("partial")) return isClassKeyword(next);
@@ -142,9 +145,8 @@ bool Parser::atUnsupportedWord() {
 /// Reports an unsupported Modelica word (E0119) and skips it; an `algorithm` section is skipped
 /// whole, up to the next section or the end of the class.
 bool Parser::skipUnsupported() {
-  bool initialAlgorithm = at(TokenKind::kw_initial) && peek(1).isWord("algorithm");
-  if (!initialAlgorithm && !atUnsupportedWord()) return false;
-  if (initialAlgorithm) take();
+  if (!atUnsupportedWord()) return false;
+  if (at(TokenKind::kw_initial)) take();
   std::string word(tok().text);
   const char* help = word == "partial" ? "remove 'partial'"
                      : word == "algorithm" ? "write the relations as equations in an 'equation' section"
@@ -153,7 +155,11 @@ bool Parser::skipUnsupported() {
          help);
   take();
   if (word != "algorithm") return true;
-  while (!at(TokenKind::eof) && !atSectionStart() && !(at(TokenKind::kw_end) && atSyncPoint())) take();
+  auto atClassEnd = [&] {
+    TokenKind k = peek(1).kind;
+    return at(TokenKind::kw_end) && (k == TokenKind::identifier || k == TokenKind::semi || k == TokenKind::eof);
+  };
+  while (!at(TokenKind::eof) && !atClassEnd() && !atSectionStart() && !atUnsupportedWord()) take();
   return true;
 }
 
@@ -235,6 +241,7 @@ bool Parser::expectEnd(TokenKind kw, SourceRange open) {
     take();
     return true;
   }
+  brokenBlocks_.push_back(kw);
   std::string closer = std::string("'end ") + spelling(kw) + "'";
   Diagnostic* d = fail(tok().range, "E0117", "expected " + closer + ", found " + describe(tok()),
                        std::string("close the block with 'end ") + spelling(kw) + ";'");
@@ -275,14 +282,17 @@ void Parser::recover(uint64_t start) {
   if (panic_) synchronize();
 }
 
-/// `end for;` / `end if;` / `end when;` closing no open block: the rest of a block whose header
-/// was broken (quietly skipped), or a stray (E0123).
+/// `end for;` / `end if;` / `end when;` closing no open block: the end of a block abandoned after
+/// an error (quietly skipped), or a stray (E0123).
 bool Parser::skipStrayEnd() {
   if (!at(TokenKind::kw_end)) return false;
   TokenKind k = peek(1).kind;
   if (k != TokenKind::kw_for && k != TokenKind::kw_if && k != TokenKind::kw_when) return false;
   if (!blockStack_.empty() && blockStack_.back() == k) return false;
-  if (!diags_.hasErrors())
+  auto broken = std::find(brokenBlocks_.rbegin(), brokenBlocks_.rend(), k);
+  if (broken != brokenBlocks_.rend())
+    brokenBlocks_.erase(std::next(broken).base());
+  else if (!quietStrayEnds_)
     report(tok().range, "E0123", std::string("'end ") + spelling(k) + "' without a matching " + quoted(k),
            "remove it, or open the block before it");
   take();
@@ -292,6 +302,7 @@ bool Parser::skipStrayEnd() {
 }
 
 void Parser::tooDeep(const char* what) {
+  quietStrayEnds_ = true;
   if (!std::exchange(reportedTooDeep_, true))
     fail(tok().range, "E0110", std::string(what) + " nested too deeply",
          "at most " + std::to_string(kMaxNestingDepth) +

@@ -4,6 +4,7 @@
 // expressions in ParseExpr.cpp.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <deque>
 #include <memory>
@@ -98,7 +99,8 @@ class Parser {
   bool atUnsupportedWord();
   bool skipUnsupported();
   bool atSyncPoint();
-  SourceRange rangeFrom(uint32_t begin) const { return {file_, begin, prev_.range.end}; }
+  /// From `begin` to the end of the last consumed token (never an inverted range).
+  SourceRange rangeFrom(uint32_t begin) const { return {file_, begin, std::max(begin, prev_.range.end)}; }
   SourceRange afterPrev() const { return {file_, prev_.range.end, prev_.range.end}; }
   uint32_t lineOf(uint32_t offset) const { return sm_.lineCol(file_, offset).line; }
 
@@ -199,6 +201,8 @@ class Parser {
   int subscriptDepth_ = 0;           ///< inside `[...]`, where `end` is an expression
   int branchDepth_ = 0;              ///< inside if/when equation bodies
   std::vector<TokenKind> blockStack_;  ///< open for/if/when blocks, innermost last
+  std::vector<TokenKind> brokenBlocks_;  ///< blocks abandoned after an error: their `end X;` comes later
+  bool quietStrayEnds_ = false;          ///< after E0110, skipped blocks leave many `end X;` behind
   ast::ClassDef* currentClass_ = nullptr;     ///< receives annotations and misplaced elements
   std::vector<const ast::ClassDef*> openClasses_;  ///< enclosing classes, outermost first
 };

@@ -218,6 +218,16 @@ TEST(Recovery, ErrorsInsideNestedClassesDoNotLeak) {
   EXPECT_EQ(p->cls().classes[1]->declarations.size(), 1u);
 }
 
+TEST(Recovery, UnsupportedSectionsAreSkippedWhole) {
+  auto p = parseText("partial model M\n  Real x;\nprotected\n  Real y;\nequation\n  x = 1;\nalgorithm\n  x := 2;\n"
+                     "  when x > 1 then y := 0; end when;\ninitial algorithm\n  y := 1;\nequation\n  y = 2;\n"
+                     "initial algorithm\n  y := 3;\nend M;\n");
+  EXPECT_EQ(p->diags.errorCount(), 5u) << p->rendered();
+  for (const auto& d : p->diags.diagnostics()) EXPECT_EQ(d.code, "E0119");
+  EXPECT_EQ(p->cls().declarations.size(), 2u);
+  EXPECT_EQ(p->cls().equations.size(), 2u);
+}
+
 TEST(Recovery, MismatchedEndNameIsNotACascade) {
   auto p = parseText("model A\n  Real x;\nend B;\nmodel C\n  Real y;\nend C;\n");
   EXPECT_EQ(p->diags.errorCount(), 1u) << p->rendered();

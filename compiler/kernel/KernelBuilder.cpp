@@ -1,0 +1,319 @@
+// buildKernels: turns a dae::Dae into the six programs of the model ABI. Residual and Jacobian go
+// through one CSE together (shared temporaries) and are then lowered as two programs, each
+// computing only the temporaries it needs: IDA evaluates the residual far more often than the
+// Jacobian, so the residual must not pay for Jacobian-only work.
+#include <algorithm>
+#include <limits>
+#include <unordered_set>
+
+#include "kernel/Jacobian.h"
+#include "kernel/Lowering.h"
+
+namespace qdot::kernel {
+namespace {
+
+using sym::Expr;
+
+std::string shorten(std::string s, size_t max = 120) {
+  if (s.size() > max) s = s.substr(0, max - 3) + "...";
+  return s;
+}
+
+class Builder {
+ public:
+  Builder(const dae::Dae& dae, sym::Context& ctx) : dae_(dae), ctx_(ctx) {}
+
+  KernelModule run() {
+    describeModel();
+    addEquationSources();
+    buildParameters();
+    buildInitialValues();
+    buildResidualAndJacobian();
+    m_.program(ProgramId::Outputs) = buildOutputs();
+    m_.program(ProgramId::Invariants) = buildInvariants();
+    return std::move(m_);
+  }
+
+ private:
+  const dae::Dae& dae_;
+  sym::Context& ctx_;
+  KernelModule m_;
+  std::vector<uint32_t> equationSource_;
+
+  uint32_t addSource(std::string label, SourceRange range, std::string text = {}) {
+    m_.sources.push_back({std::move(label), range, shorten(std::move(text))});
+    return static_cast<uint32_t>(m_.sources.size() - 1);
+  }
+
+  void describeModel() {
+    m_.name = dae_.name;
+    for (const auto& v : dae_.variables) {
+      m_.variableNames.push_back(v.name);
+      m_.isDifferential.push_back(v.kind == dae::VarKind::State);
+      m_.fixed.push_back(defaultFixed(v));
+    }
+    for (const auto& p : dae_.parameters) {
+      m_.parameterNames.push_back(p.name);
+      m_.parameterDescriptions.push_back(p.description);
+    }
+    for (const auto& o : dae_.outputs) m_.outputNames.push_back(o.name);
+    for (const auto& inv : dae_.invariants) m_.invariantNames.push_back(inv.name);
+  }
+
+  // Coordinates and velocities that are states start fixed; another state is fixed if it has a
+  // start value (or fixed = true); an algebraic variable's start is only a guess unless fixed.
+  static bool defaultFixed(const dae::Variable& v) {
+    if (v.fixed) return true;
+    if (v.kind != dae::VarKind::State) return false;
+    return v.role == dae::VarRole::Coordinate || v.role == dae::VarRole::Velocity || v.start != nullptr;
+  }
+
+  std::string variableNameOfFlat(int flatVar) const {
+    for (const auto& v : dae_.variables)
+      if (v.flatVar == flatVar) return v.name;
+    return "?";
+  }
+
+  std::string equationLabel(size_t i, const dae::Equation& e) const {
+    std::string label = "equation " + std::to_string(i + 1);
+    switch (e.origin.kind) {
+      case flat::OriginKind::EulerLagrange:
+        return label + " (Euler-Lagrange equation of " + variableNameOfFlat(e.origin.variable) + ")";
+      case flat::OriginKind::Kinematic: return label + " (velocity of " + variableNameOfFlat(e.origin.variable) + ")";
+      case flat::OriginKind::Constraint: return label + " (constraint" + e.origin.element + ")";
+      case flat::OriginKind::Equation:
+      case flat::OriginKind::InitialEquation: break;
+    }
+    return e.origin.element.empty() ? label : label + " (element " + e.origin.element + ")";
+  }
+
+  std::string equationText(const dae::Equation& e) const {
+    if (!e.lhs || !e.rhs) return {};
+    return sym::toString(ctx_, e.lhs) + " = " + sym::toString(ctx_, e.rhs);
+  }
+
+  void addEquationSources() {
+    for (size_t i = 0; i < dae_.equations.size(); ++i) {
+      const auto& e = dae_.equations[i];
+      equationSource_.push_back(addSource(equationLabel(i, e), e.origin.range, equationText(e)));
+    }
+  }
+
+  // y, y', p and time as loads (cj too for the Jacobian).
+  void bindInputs(ProgramBuilder& b, bool variables, Expr cj = nullptr) {
+    if (dae_.time) b.bindLoad(dae_.time, Op::LoadTime, 0);
+    for (uint32_t k = 0; k < dae_.parameters.size(); ++k) b.bindLoad(dae_.parameters[k].symbol, Op::LoadP, k);
+    if (cj) b.bindLoad(cj, Op::LoadCj, 0);
+    if (!variables) return;
+    for (uint32_t j = 0; j < dae_.variables.size(); ++j) {
+      b.bindLoad(dae_.variables[j].y, Op::LoadY, j);
+      if (dae_.variables[j].yp) b.bindLoad(dae_.variables[j].yp, Op::LoadYp, j);
+    }
+  }
+
+  void reportUnbound(const ProgramBuilder& b, const std::string& where) {
+    for (Expr s : b.unboundSymbols())
+      m_.errors.push_back(where + ": '" + ctx_.symbolName(s) + "' is not available there (its value is NaN)");
+  }
+
+  // --- parameters ------------------------------------------------------------------------------
+
+  // Depth-first post-order over "default of i uses j" in declaration order; cycles are reported.
+  std::vector<uint32_t> parameterOrder() {
+    size_t n = dae_.parameters.size();
+    std::unordered_map<Expr, uint32_t> index;
+    for (uint32_t k = 0; k < n; ++k) index[dae_.parameters[k].symbol] = k;
+    std::vector<std::vector<uint32_t>> uses(n);
+    for (uint32_t k = 0; k < n; ++k)
+      if (dae_.parameters[k].value)
+        for (Expr s : ctx_.freeSymbols(dae_.parameters[k].value))
+          if (auto it = index.find(s); it != index.end()) uses[k].push_back(it->second);
+    std::vector<uint32_t> order;
+    std::vector<uint8_t> state(n, 0);  // 0 new, 1 on the path, 2 done
+    for (uint32_t k = 0; k < n; ++k) visitParameter(k, uses, state, order);
+    return order;
+  }
+
+  void visitParameter(uint32_t root, const std::vector<std::vector<uint32_t>>& uses, std::vector<uint8_t>& state,
+                      std::vector<uint32_t>& order) {
+    std::vector<std::pair<uint32_t, size_t>> stack;
+    if (state[root] == 0) stack.emplace_back(root, 0), state[root] = 1;
+    while (!stack.empty()) {
+      auto& [k, next] = stack.back();
+      if (next < uses[k].size()) {
+        uint32_t j = uses[k][next++];
+        if (state[j] == 1) cyclic_.insert(j), cyclic_.insert(k);
+        if (state[j] == 0) stack.emplace_back(j, 0), state[j] = 1;
+        continue;
+      }
+      state[k] = 2;
+      order.push_back(k);
+      stack.pop_back();
+    }
+  }
+  std::unordered_set<uint32_t> cyclic_;
+
+  // p_i = overridden_i ? given_i : default_i, in dependency order.
+  void buildParameters() {
+    ProgramBuilder b("parameters");  // defaults see other parameters only (not time)
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    for (uint32_t k : parameterOrder()) {
+      const auto& p = dae_.parameters[k];
+      std::string text = p.value ? p.name + " = " + sym::toString(ctx_, p.value) : std::string();
+      b.setSource(addSource("parameter " + p.name, p.declRange, text));
+      bool usable = p.value && !cyclic_.count(k);
+      if (cyclic_.count(k)) m_.errors.push_back("parameter " + p.name + ": its binding depends on itself");
+      uint32_t given = b.emit(Op::LoadGiven, 0, 0, 0, k);
+      uint32_t overridden = b.emit(Op::LoadOverridden, 0, 0, 0, k);
+      uint32_t fallback = usable ? b.lower(p.value) : b.constant(nan);
+      uint32_t value = b.emit(Op::Select, overridden, given, fallback);
+      b.bindRegister(p.symbol, value);
+      b.store(k, value);
+    }
+    reportUnbound(b, "parameter bindings");
+    m_.program(ProgramId::Parameters) = b.finish(static_cast<uint32_t>(dae_.parameters.size()));
+  }
+
+  // --- start values ----------------------------------------------------------------------------
+
+  struct Start {
+    Expr y0 = nullptr, yp0 = nullptr;
+    uint32_t source = UINT32_MAX, derivativeSource = UINT32_MAX;
+  };
+
+  bool overParameters(Expr e) const {
+    for (Expr s : ctx_.freeSymbols(e)) {
+      bool ok = s == dae_.time;
+      for (const auto& p : dae_.parameters) ok = ok || p.symbol == s;
+      if (!ok) return false;
+    }
+    return true;
+  }
+
+  // `v = expr` or `der(x) = expr` (either side) with expr over parameters and time.
+  bool applyInitialEquation(size_t i, std::vector<Start>& starts) {
+    const dae::Equation& e = dae_.initialEquations[i];
+    if (!e.lhs || !e.rhs) return false;
+    for (int side = 0; side < 2; ++side) {
+      Expr target = side ? e.rhs : e.lhs, value = side ? e.lhs : e.rhs;
+      if (!target->isSymbol() || !overParameters(value)) continue;
+      for (size_t j = 0; j < dae_.variables.size(); ++j) {
+        const auto& v = dae_.variables[j];
+        if (v.y != target && v.yp != target) continue;
+        uint32_t src = addSource("initial equation " + std::to_string(i + 1), e.origin.range, equationText(e));
+        if (v.y == target) starts[j].y0 = value, starts[j].source = src, m_.fixed[j] = 1;
+        else starts[j].yp0 = value, starts[j].derivativeSource = src;
+        return true;
+      }
+    }
+    return false;
+  }
+
+  std::vector<Start> collectStarts() {
+    std::vector<Start> starts(dae_.variables.size());
+    for (size_t j = 0; j < dae_.variables.size(); ++j) {
+      const auto& v = dae_.variables[j];
+      starts[j].y0 = v.start;
+      starts[j].source = addSource("start value of " + v.name, v.declRange);
+    }
+    for (size_t i = 0; i < dae_.initialEquations.size(); ++i)
+      if (!applyInitialEquation(i, starts))
+        m_.errors.push_back("initial equation " + std::to_string(i + 1) + " (" +
+                            equationText(dae_.initialEquations[i]) +
+                            "): only `variable = expression` or `der(variable) = expression` over parameters "
+                            "is supported for now");
+    return starts;
+  }
+
+  // out = [y0 (n), yp0 (n), nominal (n)].
+  void buildInitialValues() {
+    std::vector<Start> starts = collectStarts();
+    ProgramBuilder b("initialValues");
+    bindInputs(b, false);
+    auto n = static_cast<uint32_t>(dae_.variables.size());
+    for (uint32_t j = 0; j < n; ++j) {
+      b.setSource(starts[j].source);
+      b.store(j, starts[j].y0 ? b.lower(starts[j].y0) : b.constant(0.0));
+    }
+    for (uint32_t j = 0; j < n; ++j) {
+      b.setSource(starts[j].derivativeSource == UINT32_MAX ? starts[j].source : starts[j].derivativeSource);
+      b.store(n + j, starts[j].yp0 ? b.lower(starts[j].yp0) : b.constant(0.0));
+    }
+    for (uint32_t j = 0; j < n; ++j) {
+      b.setSource(starts[j].source);
+      Expr nominal = dae_.variables[j].nominal;
+      b.store(2 * n + j, nominal ? b.lower(nominal) : b.constant(0.0));
+    }
+    reportUnbound(b, "start values (only parameters may be used)");
+    m_.program(ProgramId::InitialValues) = b.finish(3 * n);
+  }
+
+  // --- residual and Jacobian ---------------------------------------------------------------------
+
+  void buildResidualAndJacobian() {
+    Expr cj = ctx_.symbol("$cj");
+    JacobianEntries jac = differentiate(dae_, ctx_, cj);
+    m_.jacobianColumnStarts = jac.columnStarts;
+    m_.jacobianRowIndices = jac.rowIndices;
+    std::vector<Expr> roots;
+    for (const auto& e : dae_.equations) roots.push_back(e.residual);
+    roots.insert(roots.end(), jac.values.begin(), jac.values.end());
+    sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, roots, "$t");
+    m_.sharedTemporaries = cse.temporaries.size();
+    size_t n = dae_.equations.size();
+
+    ProgramBuilder res("residual");
+    bindInputs(res, true);
+    for (const auto& [t, value] : cse.temporaries) res.bindTemporary(t, value);
+    for (uint32_t i = 0; i < n; ++i) res.setSource(equationSource_[i]), res.store(i, res.lower(cse.outputs[i]));
+    reportUnbound(res, "residual");
+    m_.program(ProgramId::Residual) = res.finish(static_cast<uint32_t>(n));
+
+    ProgramBuilder jb("jacobian");
+    bindInputs(jb, true, cj);
+    for (const auto& [t, value] : cse.temporaries) jb.bindTemporary(t, value);
+    for (uint32_t k = 0; k < jac.values.size(); ++k) {
+      jb.setSource(equationSource_[jac.rowIndices[k]]);
+      jb.store(k, jb.lower(cse.outputs[n + k]));
+    }
+    m_.program(ProgramId::Jacobian) = jb.finish(static_cast<uint32_t>(jac.values.size()));
+  }
+
+  // --- outputs and invariants --------------------------------------------------------------------
+
+  Program buildMonitor(std::string name, const std::vector<Expr>& values, const std::vector<uint32_t>& sources) {
+    sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, values, "$t");
+    ProgramBuilder b(name);
+    bindInputs(b, true);
+    for (const auto& [t, value] : cse.temporaries) b.bindTemporary(t, value);
+    for (uint32_t i = 0; i < values.size(); ++i) b.setSource(sources[i]), b.store(i, b.lower(cse.outputs[i]));
+    reportUnbound(b, name);
+    return b.finish(static_cast<uint32_t>(values.size()));
+  }
+
+  Program buildOutputs() {
+    std::vector<Expr> values;
+    std::vector<uint32_t> sources;
+    for (const auto& o : dae_.outputs) {
+      values.push_back(o.value);
+      sources.push_back(addSource("output " + o.name, o.range, o.name + " = " + sym::toString(ctx_, o.value)));
+    }
+    return buildMonitor("outputs", values, sources);
+  }
+
+  Program buildInvariants() {
+    std::vector<Expr> values;
+    std::vector<uint32_t> sources;
+    for (const auto& inv : dae_.invariants) {
+      values.push_back(inv.value);
+      sources.push_back(addSource("invariant " + inv.name + " (" + inv.kind + ")", dae_.range));
+    }
+    return buildMonitor("invariants", values, sources);
+  }
+};
+
+}  // namespace
+
+KernelModule buildKernels(const dae::Dae& dae, sym::Context& ctx) { return Builder(dae, ctx).run(); }
+
+}  // namespace qdot::kernel

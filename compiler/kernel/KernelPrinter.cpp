@@ -1,0 +1,110 @@
+// `--emit=kernel`: the module header (names, flags, Jacobian pattern) and each program, one
+// instruction per line, with the source an instruction serves shown when it changes.
+#include <charconv>
+#include <ostream>
+
+#include "kernel/Kernel.h"
+#include "qdot/bytecode.h"
+
+namespace qdot::kernel {
+namespace {
+
+std::string number(double v) {
+  char buf[32];
+  auto res = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, res.ptr);
+}
+
+std::string join(const std::vector<std::string>& names) {
+  std::string s;
+  for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
+  return s;
+}
+
+const std::vector<std::string>* namesOfLoad(Op op, const KernelModule& m) {
+  switch (op) {
+    case Op::LoadY:
+    case Op::LoadYp: return &m.variableNames;
+    case Op::LoadP:
+    case Op::LoadGiven:
+    case Op::LoadOverridden: return &m.parameterNames;
+    default: return nullptr;
+  }
+}
+
+std::string operands(const Instr& ins, const Program& prog, const KernelModule& m) {
+  auto reg = [](uint32_t r) { return std::string("%").append(std::to_string(r)); };
+  switch (bc::info(static_cast<bc::Opcode>(ins.op)).format) {
+    case bc::Format::End:
+    case bc::Format::None: return "";
+    case bc::Format::Index: {
+      if (ins.op == Op::LoadConst) return number(prog.constants[ins.imm]);
+      const auto* names = namesOfLoad(ins.op, m);
+      return std::to_string(ins.imm) + (names && ins.imm < names->size() ? std::string(" (").append((*names)[ins.imm]) + ")" : "");
+    }
+    case bc::Format::Unary: return reg(ins.a);
+    case bc::Format::Binary: return reg(ins.a) + ", " + reg(ins.b);
+    case bc::Format::Ternary: return reg(ins.a) + ", " + reg(ins.b) + ", " + reg(ins.c);
+    case bc::Format::UnaryIndex: return reg(ins.a) + ", " + std::to_string(static_cast<int32_t>(ins.imm));
+    case bc::Format::Store: return std::string("out[").append(std::to_string(ins.imm)) + "], " + reg(ins.a);
+  }
+  return "";
+}
+
+void printHeader(std::ostream& os, const KernelModule& m) {
+  os << "kernel " << m.name << "\n";
+  os << "variables (" << m.variableCount() << "):";
+  for (size_t j = 0; j < m.variableCount(); ++j)
+    os << (j ? ", " : " ") << m.variableNames[j] << (m.isDifferential[j] ? " [differential" : " [algebraic")
+       << (m.fixed[j] ? ", fixed]" : "]");
+  os << "\nparameters (" << m.parameterNames.size() << "): " << join(m.parameterNames) << "\n";
+  os << "outputs (" << m.outputNames.size() << "): " << join(m.outputNames) << "\n";
+  os << "invariants (" << m.invariantNames.size() << "): " << join(m.invariantNames) << "\n";
+  os << "jacobian (CSC, " << m.jacobianRowIndices.size() << " nonzeros, " << m.sharedTemporaries
+     << " CSE temporaries shared with the residual):\n";
+  for (size_t j = 0; j < m.variableCount(); ++j) {
+    os << "  column " << j << " (" << m.variableNames[j] << "): rows";
+    for (int32_t k = m.jacobianColumnStarts[j]; k < m.jacobianColumnStarts[j + 1]; ++k)
+      os << " " << m.jacobianRowIndices[k];
+    os << "\n";
+  }
+  for (const auto& e : m.errors) os << "unsupported: " << e << "\n";
+}
+
+}  // namespace
+
+const char* mnemonic(Op op) { return bc::info(static_cast<bc::Opcode>(op)).mnemonic; }
+
+std::string describeLocation(const SourceManager& sm, SourceRange r) {
+  if (!r.valid()) return "";
+  return sm.name(r.file) + ":" + std::to_string(sm.lineCol(r.file, r.begin).line);
+}
+
+void printProgram(std::ostream& os, const Program& prog, const KernelModule& m) {
+  os << "\nfunction " << prog.name << ": " << prog.outputCount << " outputs, " << prog.code.size()
+     << " instructions, " << prog.constants.size() << " constants\n";
+  uint32_t source = UINT32_MAX - 1;
+  for (size_t i = 0; i < prog.code.size(); ++i) {
+    const Instr& ins = prog.code[i];
+    if (ins.source != source && ins.source < m.sources.size()) os << "  ; " << m.sources[ins.source].label << "\n";
+    source = ins.source;
+    std::string lhs = ins.op == Op::Store || ins.op == Op::Ret ? "" : std::string("%").append(std::to_string(i)) + " = ";
+    std::string ops = operands(ins, prog, m);
+    os << "  " << lhs << mnemonic(ins.op) << (ops.empty() ? "" : " " + ops) << "\n";
+  }
+}
+
+void printKernels(std::ostream& os, const KernelModule& m, const SourceManager* sm) {
+  printHeader(os, m);
+  if (sm) {
+    os << "sources:\n";
+    for (size_t s = 0; s < m.sources.size(); ++s) {
+      std::string where = describeLocation(*sm, m.sources[s].range);
+      os << "  " << m.sources[s].label << (where.empty() ? "" : " at " + where)
+         << (m.sources[s].text.empty() ? "" : ": " + m.sources[s].text) << "\n";
+    }
+  }
+  for (const Program& p : m.programs) printProgram(os, p, m);
+}
+
+}  // namespace qdot::kernel

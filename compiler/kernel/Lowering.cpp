@@ -1,0 +1,204 @@
+// Lowering of DAG nodes to kernel instructions. Sums and products are chained in the order the
+// symbolic evaluator uses (constant first, then terms/factors in canonical order), so the kernel
+// rounds like sym::evaluate except where noted: divisions replace multiplications by a reciprocal,
+// small integer powers use repeated multiplication (`powi`), x^2 is x*x and x^0.5 is sqrt(x).
+#include "kernel/Lowering.h"
+
+#include <bit>
+#include <cmath>
+#include <limits>
+
+namespace qdot::kernel {
+namespace {
+
+// Exponents up to this magnitude use powi (repeated squaring); larger ones use pow.
+constexpr double kMaxPowi = 16;
+
+bool isSmallInteger(double e) { return e == std::trunc(e) && std::fabs(e) <= kMaxPowi; }
+
+}  // namespace
+
+Op opcodeOf(sym::Kind k) {
+  using sym::Kind;
+  switch (k) {
+    case Kind::Constant:
+    case Kind::Symbol:
+    case Kind::Add:
+    case Kind::Mul:
+    case Kind::Pow: return Op::Ret;
+    case Kind::Sin: return Op::Sin;
+    case Kind::Cos: return Op::Cos;
+    case Kind::Tan: return Op::Tan;
+    case Kind::Asin: return Op::Asin;
+    case Kind::Acos: return Op::Acos;
+    case Kind::Atan: return Op::Atan;
+    case Kind::Sinh: return Op::Sinh;
+    case Kind::Cosh: return Op::Cosh;
+    case Kind::Tanh: return Op::Tanh;
+    case Kind::Exp: return Op::Exp;
+    case Kind::Log: return Op::Log;
+    case Kind::Abs: return Op::Abs;
+    case Kind::Sign: return Op::Sign;
+    case Kind::Atan2: return Op::Atan2;
+    case Kind::Min: return Op::Min;
+    case Kind::Max: return Op::Max;
+    case Kind::Lt: return Op::Lt;
+    case Kind::Le: return Op::Le;
+    case Kind::Eq: return Op::Eq;
+    case Kind::Ne: return Op::Ne;
+    case Kind::And: return Op::And;
+    case Kind::Or: return Op::Or;
+    case Kind::Not: return Op::Not;
+    case Kind::Select: return Op::Select;
+  }
+  return Op::Ret;
+}
+
+uint32_t ProgramBuilder::emit(Op op, uint32_t a, uint32_t b, uint32_t c, uint32_t imm) {
+  program_.code.push_back({op, a, b, c, imm, source_});
+  return static_cast<uint32_t>(program_.code.size() - 1);
+}
+
+uint32_t ProgramBuilder::constant(double v) {
+  uint64_t bits = std::bit_cast<uint64_t>(v == 0.0 ? 0.0 : v);
+  if (std::isnan(v)) bits = std::bit_cast<uint64_t>(std::numeric_limits<double>::quiet_NaN());
+  auto it = constants_.find(bits);
+  if (it != constants_.end()) return it->second;
+  auto index = static_cast<uint32_t>(program_.constants.size());
+  program_.constants.push_back(std::bit_cast<double>(bits));
+  uint32_t r = emit(Op::LoadConst, 0, 0, 0, index);
+  constants_.emplace(bits, r);
+  return r;
+}
+
+// Children that need registers: arguments, non-constant exponents, a temporary's value.
+void ProgramBuilder::pushChildren(sym::Expr e, std::vector<std::pair<sym::Expr, bool>>& stack) {
+  std::vector<sym::Expr> kids;
+  if (e->isSymbol()) {
+    auto t = temporaries_.find(e);
+    if (t != temporaries_.end()) kids.push_back(t->second);
+  } else if (e->kind == sym::Kind::Pow) {
+    kids.push_back(e->args[0]);
+    if (!e->args[1]->isConstant()) kids.push_back(e->args[1]);
+  } else {
+    kids.assign(e->args.begin(), e->args.end());
+    for (sym::Expr x : e->exps)
+      if (!x->isConstant()) kids.push_back(x);
+  }
+  for (auto it = kids.rbegin(); it != kids.rend(); ++it)
+    if (!memo_.count(*it)) stack.emplace_back(*it, false);
+}
+
+uint32_t ProgramBuilder::lower(sym::Expr root) {
+  if (auto it = memo_.find(root); it != memo_.end()) return it->second;
+  std::vector<std::pair<sym::Expr, bool>> stack{{root, false}};
+  while (!stack.empty()) {
+    auto [e, expanded] = stack.back();
+    if (memo_.count(e)) {
+      stack.pop_back();
+    } else if (!expanded) {
+      stack.back().second = true;
+      pushChildren(e, stack);
+    } else {
+      stack.pop_back();
+      memo_[e] = emitNode(e);
+    }
+  }
+  return memo_.at(root);
+}
+
+uint32_t ProgramBuilder::emitNode(sym::Expr e) {
+  switch (e->kind) {
+    case sym::Kind::Constant: return constant(e->value);
+    case sym::Kind::Symbol: return emitSymbol(e);
+    case sym::Kind::Add: return emitAdd(e);
+    case sym::Kind::Mul: return emitMul(e);
+    case sym::Kind::Pow: return emitPow(e);
+    default: break;
+  }
+  uint32_t a = reg(e->args[0]);
+  uint32_t b = e->args.size() > 1 ? reg(e->args[1]) : 0;
+  uint32_t c = e->args.size() > 2 ? reg(e->args[2]) : 0;
+  return emit(opcodeOf(e->kind), a, b, c);
+}
+
+uint32_t ProgramBuilder::emitSymbol(sym::Expr e) {
+  if (auto t = temporaries_.find(e); t != temporaries_.end()) return reg(t->second);
+  if (auto l = loads_.find(e); l != loads_.end()) return emit(l->second.first, 0, 0, 0, l->second.second);
+  unbound_.push_back(e);
+  return constant(std::numeric_limits<double>::quiet_NaN());
+}
+
+// c + k0*x0 + k1*x1 + ...: accumulated left to right; k = 1 adds, k = -1 subtracts.
+uint32_t ProgramBuilder::emitAdd(sym::Expr e) {
+  uint32_t acc = kNone;
+  size_t j = 0, n = e->args.size();
+  auto term = [&](size_t i) {
+    double k = e->coefs[i];
+    uint32_t x = reg(e->args[i]);
+    return k == 1.0 ? x : k == -1.0 ? emit(Op::Neg, x) : emit(Op::Mul, constant(k), x);
+  };
+  if (e->value != 0.0) {
+    acc = constant(e->value);
+  } else if (n >= 2 && e->coefs[0] == -1.0) {  // -x0 + k1*x1 == k1*x1 - x0 exactly
+    acc = emit(Op::Sub, term(1), reg(e->args[0]));
+    j = 2;
+  }
+  for (; j < n; ++j) {
+    double k = e->coefs[j];
+    if (acc == kNone) acc = term(j);
+    else if (k == -1.0) acc = emit(Op::Sub, acc, reg(e->args[j]));
+    else acc = emit(Op::Add, acc, term(j));
+  }
+  return acc;
+}
+
+// k * Π b^e: the coefficient and the factors with non-negative (or symbolic) exponents multiply
+// left to right, then the factors with negative constant exponents divide.
+uint32_t ProgramBuilder::emitMul(sym::Expr e) {
+  double k = e->value;
+  uint32_t acc = k == 1.0 || k == -1.0 ? kNone : constant(k);
+  size_t n = e->args.size();
+  for (size_t j = 0; j < n; ++j) {
+    sym::Expr x = e->exps[j];
+    if (x->isConstant() && x->value < 0) continue;
+    uint32_t f = x->isConstant() ? power(reg(e->args[j]), x->value) : emit(Op::Pow, reg(e->args[j]), reg(x));
+    acc = acc == kNone ? f : emit(Op::Mul, acc, f);
+  }
+  for (size_t j = 0; j < n; ++j) {
+    sym::Expr x = e->exps[j];
+    if (!x->isConstant() || x->value >= 0) continue;
+    uint32_t g = power(reg(e->args[j]), -x->value);
+    acc = emit(Op::Div, acc == kNone ? constant(1.0) : acc, g);
+  }
+  return k == -1.0 ? emit(Op::Neg, acc) : acc;
+}
+
+uint32_t ProgramBuilder::emitPow(sym::Expr e) {
+  uint32_t base = reg(e->args[0]);
+  sym::Expr x = e->args[1];
+  if (!x->isConstant()) return emit(Op::Pow, base, reg(x));
+  double v = x->value;
+  if (v == -1.0 || v == -0.5 || v == -2.0) {
+    uint32_t one = constant(1.0);  // sequenced: the order of emission must not depend on the compiler
+    return emit(Op::Div, one, power(base, -v));
+  }
+  return power(base, v);
+}
+
+// base^v for a constant v: x, x*x, sqrt(x), powi for small integers, else pow.
+uint32_t ProgramBuilder::power(uint32_t base, double v) {
+  if (v == 1.0) return base;
+  if (v == 2.0) return emit(Op::Mul, base, base);
+  if (v == 0.5) return emit(Op::Sqrt, base);
+  if (v == 0.0) return constant(1.0);
+  if (isSmallInteger(v)) return emit(Op::Powi, base, 0, 0, static_cast<uint32_t>(static_cast<int32_t>(v)));
+  return emit(Op::Pow, base, constant(v));
+}
+
+Program ProgramBuilder::finish(uint32_t outputCount) {
+  program_.outputCount = outputCount;
+  return std::move(program_);
+}
+
+}  // namespace qdot::kernel

@@ -1,0 +1,464 @@
+// IdaSession: SUNDIALS IDA over a QdotModel. The model's residual and analytic Jacobian are called
+// through static callbacks; every SUNDIALS call goes through Impl::check, which throws IdaError
+// with a sentence from IdaFlags.cpp. Model failures are recorded (time, lastError) for that text.
+#include "ida/IdaSession.h"
+
+#include <fmt/format.h>
+#include <ida/ida.h>
+#include <ida/ida_ls.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunlinsol/sunlinsol_klu.h>
+#include <sunmatrix/sunmatrix_dense.h>
+#include <sunmatrix/sunmatrix_sparse.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "ida/IdaFlags.h"
+#include "ida/ModelCheck.h"
+
+namespace qdot::rt {
+
+std::string_view linearSolverName(LinearSolverKind kind) {
+  switch (kind) {
+    case LinearSolverKind::Auto:
+      return "auto";
+    case LinearSolverKind::Dense:
+      return "dense";
+    case LinearSolverKind::Klu:
+      return "klu";
+  }
+  return "auto";
+}
+
+std::optional<LinearSolverKind> parseLinearSolver(std::string_view text) {
+  for (auto kind : {LinearSolverKind::Auto, LinearSolverKind::Dense, LinearSolverKind::Klu})
+    if (text == linearSolverName(kind)) return kind;
+  return std::nullopt;
+}
+
+LinearSolverKind chooseLinearSolver(uint32_t n, uint32_t nonzeros) {
+  if (n <= kDenseMaxAuto) return LinearSolverKind::Dense;
+  double fill = static_cast<double>(nonzeros) / (static_cast<double>(n) * n);
+  if (n <= 2000 && fill >= 0.3) return LinearSolverKind::Dense;
+  return LinearSolverKind::Klu;
+}
+
+namespace {
+
+/// Index of the first non-finite entry, or -1.
+long firstNonFinite(const double* values, std::size_t count) {
+  for (std::size_t i = 0; i < count; ++i)
+    if (!std::isfinite(values[i])) return static_cast<long>(i);
+  return -1;
+}
+
+double* data(N_Vector v) { return N_VGetArrayPointer(v); }
+
+/// Largest number of IDA warnings kept (IDA repeats some of them every step).
+constexpr std::size_t kMaxWarnings = 10;
+
+/// IDACalcIC attempts, each with the distance to its tout1 shrunk by kCalcICShrink.
+constexpr int kCalcICAttempts = 4;
+constexpr double kCalcICShrink = 1e-3;
+
+/// |F_i| at or below this counts as zero when deciding whether IDACalcIC is needed.
+constexpr double kConsistentResidual = 1e-14;
+
+}  // namespace
+
+struct IdaSession::Impl {
+  const QdotModel& model;
+  std::vector<double> p;
+  SessionOptions options;
+  uint32_t n;
+  LinearSolverKind kind = LinearSolverKind::Dense;
+
+  SUNContext context = nullptr;
+  void* ida = nullptr;
+  N_Vector y = nullptr, yp = nullptr, id = nullptr, atol = nullptr;
+  SUNMatrix matrix = nullptr;
+  SUNLinearSolver solver = nullptr;
+
+  std::vector<double> nominal;
+  std::vector<sunindextype> columnStarts, rowIndices;  // the CSC pattern in SUNDIALS' index type
+  std::vector<double> jacobianValues;                  // dense only: values before scattering
+  ToleranceVector tolerances;
+  double t;
+  double tout = 0;
+  bool calcIC = false;
+
+  // What the last failure was, for the checking helper's message.
+  bool modelFailed = false;
+  double modelFailureTime = 0;
+  std::string modelError;
+  std::string solverMessage;
+  std::vector<std::string> warnings;
+
+  Impl(const QdotModel& m, std::vector<double> values, const SessionOptions& o)
+      : model(m), p(std::move(values)), options(o), n(m.nVariables), t(o.t0) {}
+  ~Impl();
+
+  void setup();
+  void createVectors();
+  void loadInitialValues();
+  void createIntegrator();
+  void attachLinearSolver();
+  void applyTolerances();
+  void initialize(double tout1);
+  void calculateConsistentValues(double tout1);
+  bool startIsConsistent();
+  void noteChangedFixedStarts(const std::vector<double>& before);
+  double advanceTo(double target);
+  SolverStats stats();
+
+  void check(int flag, std::string_view call, FlagFamily family = FlagFamily::Ida);
+  template <class Handle>
+  Handle created(Handle handle, std::string_view call) {
+    check(handle ? 0 : -1, call, FlagFamily::Allocation);
+    return handle;
+  }
+  [[noreturn]] void failOutsideIda(const std::string& what, double time);
+  void clearFailure();
+  std::string singularNote() const;
+  int onModelFailure(double time, std::string message);
+  int evaluateResidual(double time, const double* yv, const double* ypv, double* F);
+  int evaluateJacobian(double time, double cj, N_Vector yv, N_Vector ypv, SUNMatrix J);
+  void scatterDense(SUNMatrix J);
+
+  static int residualCallback(sunrealtype time, N_Vector yv, N_Vector ypv, N_Vector F, void* self);
+  static int jacobianCallback(sunrealtype time, sunrealtype cj, N_Vector yv, N_Vector ypv, N_Vector r, SUNMatrix J,
+                              void* self, N_Vector, N_Vector, N_Vector);
+  static void errorCallback(int code, const char* module, const char* function, char* message, void* self);
+};
+
+IdaSession::Impl::~Impl() {
+  if (ida) IDAFree(&ida);
+  if (solver) SUNLinSolFree(solver);
+  if (matrix) SUNMatDestroy(matrix);
+  for (N_Vector v : {y, yp, id, atol})
+    if (v) N_VDestroy(v);
+  if (context) SUNContext_Free(&context);
+}
+
+// --- the checking helper --------------------------------------------------------------------
+
+void IdaSession::Impl::check(int flag, std::string_view call, FlagFamily family) {
+  bool ok = family == FlagFamily::Ida ? flag >= 0 : flag == 0;
+  if (ok) return;
+  FailureContext c;
+  c.call = call;
+  c.tout = tout;
+  c.maxSteps = options.maxStepsPerOutput;
+  c.time = t;
+  if (ida) {  // plain getters: they fail only on a null ida, which is excluded here
+    IDAGetCurrentTime(ida, &c.time);
+    IDAGetCurrentStep(ida, &c.step);
+  }
+  c.modelFailed = modelFailed;
+  c.modelError = modelError;
+  c.solverMessage = solverMessage;
+  c.linearSolverNote = singularNote();
+  if (modelFailed) c.time = modelFailureTime;
+  throw IdaError(describeFailure(flag, family, c), c.time);
+}
+
+void IdaSession::Impl::failOutsideIda(const std::string& what, double time) {
+  throw IdaError(fmt::format("{} at t = {:.10g}: {}", what, time, modelError.empty() ? "(no message)" : modelError),
+                 time);
+}
+
+std::string IdaSession::Impl::singularNote() const {
+  // The last factorisation's outcome: a zero pivot names the unknown whose column is dependent.
+  if (!solver) return "";
+  long column = -1;
+  if (kind == LinearSolverKind::Dense) {
+    sunindextype pivot = SUNLinSolLastFlag(solver);  // 1-based column of a zero pivot, else 0
+    if (pivot > 0 && pivot <= static_cast<sunindextype>(n)) column = static_cast<long>(pivot - 1);
+  } else {
+    // KLU's own status of its last call (the SUNDIALS flag only says "package failure")
+    sun_klu_common* common = SUNLinSol_KLUGetCommon(solver);
+    bool singular = common && common->status == KLU_SINGULAR;
+    if (singular && common->singular_col >= 0 && common->singular_col < static_cast<sunindextype>(n))
+      column = static_cast<long>(common->singular_col);
+  }
+  if (column < 0) return "";
+  return fmt::format(
+      "the Newton matrix is singular at the column of {} (no equation determines it, or the "
+      "system has a higher index)",
+      nameList(model.variableNames, n)[column]);
+}
+
+void IdaSession::Impl::clearFailure() {
+  modelFailed = false;
+  modelError.clear();
+  solverMessage.clear();
+}
+
+// --- model callbacks ------------------------------------------------------------------------
+
+int IdaSession::Impl::onModelFailure(double time, std::string message) {
+  modelFailed = true;
+  modelFailureTime = time;
+  modelError = std::move(message);
+  return 1;  // recoverable: IDA retries with a smaller step and gives up after repeated failures
+}
+
+int IdaSession::Impl::evaluateResidual(double time, const double* yv, const double* ypv, double* F) {
+  int rc = model.residual(&model, time, yv, ypv, p.data(), F);
+  if (rc != 0) {
+    std::string text = modelLastError(model);
+    return onModelFailure(time, text.empty() ? fmt::format("the residual returned {}", rc) : text);
+  }
+  long bad = firstNonFinite(F, n);
+  if (bad >= 0) return onModelFailure(time, fmt::format("residual F[{}] evaluated to {}", bad, F[bad]));
+  return 0;
+}
+
+int IdaSession::Impl::residualCallback(sunrealtype time, N_Vector yv, N_Vector ypv, N_Vector F, void* self) {
+  return static_cast<Impl*>(self)->evaluateResidual(time, data(yv), data(ypv), data(F));
+}
+
+void IdaSession::Impl::scatterDense(SUNMatrix J) {
+  for (uint32_t column = 0; column < n; ++column) {
+    double* out = SUNDenseMatrix_Column(J, column);
+    std::fill(out, out + n, 0.0);
+    for (sunindextype k = columnStarts[column]; k < columnStarts[column + 1]; ++k)
+      out[rowIndices[k]] = jacobianValues[k];
+  }
+}
+
+int IdaSession::Impl::evaluateJacobian(double time, double cj, N_Vector yv, N_Vector ypv, SUNMatrix J) {
+  double* values = jacobianValues.data();
+  if (kind == LinearSolverKind::Klu) {
+    // IDA zeroes the matrix (pattern included) before every call: restore the pattern each time.
+    std::copy(columnStarts.begin(), columnStarts.end(), SUNSparseMatrix_IndexPointers(J));
+    std::copy(rowIndices.begin(), rowIndices.end(), SUNSparseMatrix_IndexValues(J));
+    values = SUNSparseMatrix_Data(J);
+  }
+  int rc = model.jacobian(&model, time, data(yv), data(ypv), p.data(), cj, values);
+  if (rc != 0) {
+    std::string text = modelLastError(model);
+    return onModelFailure(time, text.empty() ? fmt::format("the Jacobian returned {}", rc) : text);
+  }
+  long bad = firstNonFinite(values, model.jacobianNonzeros);
+  if (bad >= 0) return onModelFailure(time, fmt::format("Jacobian entry {} evaluated to {}", bad, values[bad]));
+  if (kind == LinearSolverKind::Dense) scatterDense(J);
+  return 0;
+}
+
+int IdaSession::Impl::jacobianCallback(sunrealtype time, sunrealtype cj, N_Vector yv, N_Vector ypv, N_Vector,
+                                       SUNMatrix J, void* self, N_Vector, N_Vector, N_Vector) {
+  return static_cast<Impl*>(self)->evaluateJacobian(time, cj, yv, ypv, J);
+}
+
+void IdaSession::Impl::errorCallback(int code, const char*, const char*, char* message, void* self) {
+  auto& s = *static_cast<Impl*>(self);
+  std::string text = message ? message : "";
+  if (code != IDA_WARNING) {
+    s.solverMessage = text;
+  } else if (s.warnings.size() < kMaxWarnings) {
+    s.warnings.push_back("IDA: " + text);
+  }
+}
+
+// --- setup ----------------------------------------------------------------------------------
+
+void IdaSession::Impl::setup() {
+  if (auto problem = checkModel(model)) throw IdaError(*problem, options.t0);
+  if (p.size() != model.nParameters)
+    throw IdaError(fmt::format("{} parameter values given, the model has {}", p.size(), model.nParameters), options.t0);
+  check(SUNContext_Create(nullptr, &context), "SUNContext_Create", FlagFamily::Allocation);
+  if (n == 0) return;  // nothing to integrate: the session only carries time
+  createVectors();
+  loadInitialValues();
+  createIntegrator();
+  attachLinearSolver();
+}
+
+void IdaSession::Impl::createVectors() {
+  y = created(N_VNew_Serial(n, context), "N_VNew_Serial");
+  yp = created(N_VNew_Serial(n, context), "N_VNew_Serial");
+  id = created(N_VNew_Serial(n, context), "N_VNew_Serial");
+  atol = created(N_VNew_Serial(n, context), "N_VNew_Serial");
+  for (uint32_t i = 0; i < n; ++i)
+    data(id)[i] = model.isDifferential[i] ? 1.0 : 0.0;
+}
+
+void IdaSession::Impl::loadInitialValues() {
+  nominal.assign(n, 0.0);
+  std::fill(data(y), data(y) + n, 0.0);
+  std::fill(data(yp), data(yp) + n, 0.0);
+  if (model.initialValues(&model, p.data(), options.t0, data(y), data(yp), nominal.data()) != 0) {
+    modelError = modelLastError(model);
+    failOutsideIda("the start values could not be computed", options.t0);
+  }
+  long bad = firstNonFinite(data(y), n);
+  if (bad >= 0) {
+    modelError = fmt::format("the start value of {} is {}", nameList(model.variableNames, n)[bad], data(y)[bad]);
+    failOutsideIda("the start values are not finite", options.t0);
+  }
+}
+
+void IdaSession::Impl::createIntegrator() {
+  ida = created(IDACreate(context), "IDACreate");
+  check(IDASetErrHandlerFn(ida, &Impl::errorCallback, this), "IDASetErrHandlerFn");
+  check(IDASetUserData(ida, this), "IDASetUserData");
+  check(IDAInit(ida, &Impl::residualCallback, options.t0, y, yp), "IDAInit");
+  applyTolerances();
+  check(IDASetId(ida, id), "IDASetId");
+  check(IDASetMaxNumSteps(ida, options.maxStepsPerOutput), "IDASetMaxNumSteps");
+}
+
+void IdaSession::Impl::applyTolerances() {
+  tolerances = buildTolerances(options.rtol, options.atol, {data(y), n}, nominal, {model.isDifferential, n});
+  std::copy(tolerances.atol.begin(), tolerances.atol.end(), data(atol));
+  check(IDASVtolerances(ida, options.rtol, atol), "IDASVtolerances");
+}
+
+void IdaSession::Impl::attachLinearSolver() {
+  uint32_t nnz = model.jacobianNonzeros;
+  kind = options.linearSolver == LinearSolverKind::Auto ? chooseLinearSolver(n, nnz) : options.linearSolver;
+  if (kind == LinearSolverKind::Dense && n > kDenseMaxForced)
+    throw IdaError(fmt::format("the dense linear solver would need a {} x {} matrix ({:.1f} GiB): use "
+                               "--linear-solver klu",
+                               n, n, 8.0 * n * n / (1u << 30)),
+                   options.t0);
+  columnStarts.assign(model.jacobianColumnStarts, model.jacobianColumnStarts + n + 1);
+  rowIndices.assign(model.jacobianRowIndices, model.jacobianRowIndices + nnz);
+  if (kind == LinearSolverKind::Klu) {
+    matrix = created(SUNSparseMatrix(n, n, std::max<uint32_t>(nnz, 1), CSC_MAT, context), "SUNSparseMatrix");
+    solver = created(SUNLinSol_KLU(y, matrix, context), "SUNLinSol_KLU");
+  } else {
+    jacobianValues.assign(nnz, 0.0);
+    matrix = created(SUNDenseMatrix(n, n, context), "SUNDenseMatrix");
+    solver = created(SUNLinSol_Dense(y, matrix, context), "SUNLinSol_Dense");
+  }
+  check(IDASetLinearSolver(ida, solver, matrix), "IDASetLinearSolver", FlagFamily::LinearSolverInterface);
+  check(IDASetJacFn(ida, &Impl::jacobianCallback), "IDASetJacFn", FlagFamily::LinearSolverInterface);
+}
+
+// --- consistent initial values --------------------------------------------------------------
+
+bool IdaSession::Impl::startIsConsistent() {
+  std::vector<double> F(n);
+  clearFailure();
+  if (evaluateResidual(options.t0, data(y), data(yp), F.data()) != 0)
+    failOutsideIda("the residual cannot be evaluated at the start", options.t0);
+  return std::all_of(F.begin(), F.end(), [](double f) { return std::abs(f) <= kConsistentResidual; });
+}
+
+void IdaSession::Impl::noteChangedFixedStarts(const std::vector<double>& before) {
+  if (!model.fixedStarts) return;
+  std::vector<int32_t> fixed(n, 0);
+  if (model.fixedStarts(&model, fixed.data()) != 0) return;
+  auto names = nameList(model.variableNames, n);
+  for (uint32_t i = 0; i < n; ++i) {
+    double now = data(y)[i];
+    bool changed = std::abs(now - before[i]) > 1e-6 * std::max(1.0, std::abs(before[i]));
+    if (model.isDifferential[i] || !fixed[i] || !changed) continue;
+    warnings.push_back(
+        fmt::format("the fixed start value of algebraic {} ({:.10g}) was changed to {:.10g} to make "
+                    "the initial values consistent",
+                    names[i], before[i], now));
+  }
+}
+
+void IdaSession::Impl::calculateConsistentValues(double tout1) {
+  // IDACalcIC takes its pseudo step from tout1 - t0. Its Newton matrix is exact only when that
+  // step is short against the model's time scales, so a far first output time (Robertson: 1e10)
+  // can make it fail; then it is retried from the start values with a step 1000 times shorter.
+  double span = tout1 - options.t0;
+  for (int attempt = 1;; ++attempt) {
+    try {
+      clearFailure();
+      tout = options.t0 + span;
+      check(IDACalcIC(ida, IDA_YA_YDP_INIT, tout), "IDACalcIC");
+      return;
+    } catch (const IdaError&) {
+      if (attempt == kCalcICAttempts) throw;
+    }
+    span *= kCalcICShrink;
+    check(IDAReInit(ida, options.t0, y, yp), "IDAReInit");  // y, yp still hold the start values
+  }
+}
+
+void IdaSession::Impl::initialize(double tout1) {
+  if (n == 0) return;
+  bool hasAlgebraic = std::any_of(model.isDifferential, model.isDifferential + n, [](int32_t d) { return d == 0; });
+  if (!hasAlgebraic && startIsConsistent()) return;
+  std::vector<double> before(data(y), data(y) + n);
+  calculateConsistentValues(tout1);
+  check(IDAGetConsistentIC(ida, y, yp), "IDAGetConsistentIC");
+  calcIC = true;
+  noteChangedFixedStarts(before);
+  // Automatic scales from the consistent values. IDA binds its tolerance data during its initial
+  // setup (which IDACalcIC has done), so new tolerances need a restart from the consistent point.
+  check(IDAReInit(ida, options.t0, y, yp), "IDAReInit");
+  applyTolerances();
+}
+
+// --- integration ----------------------------------------------------------------------------
+
+double IdaSession::Impl::advanceTo(double target) {
+  tout = target;
+  if (n == 0) return t = target;
+  clearFailure();
+  sunrealtype reached = t;
+  check(IDASolve(ida, target, &reached, y, yp, IDA_NORMAL), "IDASolve");
+  t = reached;
+  return t;
+}
+
+SolverStats IdaSession::Impl::stats() {
+  SolverStats s;
+  if (!ida) return s;
+  check(IDAGetNumSteps(ida, &s.steps), "IDAGetNumSteps");
+  check(IDAGetNumResEvals(ida, &s.residualEvaluations), "IDAGetNumResEvals");
+  check(IDAGetNumJacEvals(ida, &s.jacobianEvaluations), "IDAGetNumJacEvals", FlagFamily::LinearSolverInterface);
+  check(IDAGetNumNonlinSolvIters(ida, &s.nonlinearIterations), "IDAGetNumNonlinSolvIters");
+  check(IDAGetNumErrTestFails(ida, &s.errorTestFailures), "IDAGetNumErrTestFails");
+  check(IDAGetNumNonlinSolvConvFails(ida, &s.convergenceFailures), "IDAGetNumNonlinSolvConvFails");
+  check(IDAGetLastStep(ida, &s.lastStep), "IDAGetLastStep");
+  check(IDAGetLastOrder(ida, &s.lastOrder), "IDAGetLastOrder");
+  return s;
+}
+
+// --- the public face ------------------------------------------------------------------------
+
+IdaSession::IdaSession(const QdotModel& model, std::vector<double> p, const SessionOptions& options)
+    : impl_(std::make_unique<Impl>(model, std::move(p), options)) {
+  impl_->setup();  // on a throw, impl_ is destroyed and frees what was created
+}
+
+IdaSession::~IdaSession() = default;
+
+void IdaSession::initialize(double tout1) { impl_->initialize(tout1); }
+
+void IdaSession::setStopTime(double tstop) {
+  if (impl_->ida) impl_->check(IDASetStopTime(impl_->ida, tstop), "IDASetStopTime");
+}
+
+double IdaSession::advanceTo(double tout) { return impl_->advanceTo(tout); }
+double IdaSession::time() const { return impl_->t; }
+
+std::span<const double> IdaSession::y() const {
+  return impl_->y ? std::span<const double>(data(impl_->y), impl_->n) : std::span<const double>();
+}
+
+std::span<const double> IdaSession::yp() const {
+  return impl_->yp ? std::span<const double>(data(impl_->yp), impl_->n) : std::span<const double>();
+}
+
+std::span<const double> IdaSession::parameters() const { return impl_->p; }
+const QdotModel& IdaSession::model() const { return impl_->model; }
+SolverStats IdaSession::stats() const { return impl_->stats(); }
+const ToleranceSummary& IdaSession::tolerances() const { return impl_->tolerances.summary; }
+std::span<const double> IdaSession::absoluteTolerances() const { return impl_->tolerances.atol; }
+LinearSolverKind IdaSession::linearSolver() const { return impl_->kind; }
+bool IdaSession::computedInitialValues() const { return impl_->calcIC; }
+const std::vector<std::string>& IdaSession::warnings() const { return impl_->warnings; }
+
+}  // namespace qdot::rt

@@ -1,0 +1,94 @@
+// Per-variable absolute tolerances: scales from nominal values or from the start values, grouped
+// by kind (differential / algebraic) so a zero start value gets a floor tied to its neighbours.
+// The rule is documented in Tolerances.h and runtime/README.md.
+#include "ida/Tolerances.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace qdot::rt {
+namespace {
+
+bool hasNominal(double nominal) { return std::isfinite(nominal) && nominal > 0; }
+
+double magnitude(double y0, double nominal) {
+  if (hasNominal(nominal)) return nominal;
+  return std::isfinite(y0) ? std::abs(y0) : 0.0;
+}
+
+/// Largest magnitude over the unknowns of one kind (kind < 0: all unknowns).
+double largestMagnitude(std::span<const double> y0, std::span<const double> nominal,
+                        std::span<const int32_t> isDifferential, int kind) {
+  double largest = 0;
+  for (std::size_t i = 0; i < y0.size(); ++i) {
+    if (kind >= 0 && (isDifferential[i] != 0) != (kind != 0)) continue;
+    largest = std::max(largest, magnitude(y0[i], nominal[i]));
+  }
+  return std::isfinite(largest) ? largest : 0.0;
+}
+
+double floorFor(double kindLargest, double allLargest) {
+  if (allLargest <= 0) return 1.0;
+  // A kind whose values are all zero or negligible (roundoff such as 1e-30 left by IDACalcIC)
+  // would give an absurdly small floor: it borrows the overall magnitude instead.
+  bool kindCounts = kindLargest > kAutomaticScaleFloorFactor * allLargest;
+  return kAutomaticScaleFloorFactor * (kindCounts ? kindLargest : allLargest);
+}
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0;
+  auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  if (values.size() % 2 == 1) return *middle;
+  double upper = *middle;
+  double lower = *std::max_element(values.begin(), middle);
+  return 0.5 * (lower + upper);
+}
+
+}  // namespace
+
+std::vector<double> toleranceScales(std::span<const double> y0, std::span<const double> nominal,
+                                    std::span<const int32_t> isDifferential) {
+  double all = largestMagnitude(y0, nominal, isDifferential, -1);
+  double floors[2] = {floorFor(largestMagnitude(y0, nominal, isDifferential, 0), all),
+                      floorFor(largestMagnitude(y0, nominal, isDifferential, 1), all)};
+  std::vector<double> scales(y0.size());
+  for (std::size_t i = 0; i < y0.size(); ++i) {
+    if (hasNominal(nominal[i])) {
+      scales[i] = nominal[i];
+    } else {
+      scales[i] = std::max(magnitude(y0[i], 0.0), floors[isDifferential[i] != 0 ? 1 : 0]);
+    }
+  }
+  return scales;
+}
+
+ToleranceVector buildTolerances(double rtol, std::optional<double> atol, std::span<const double> y0,
+                                std::span<const double> nominal, std::span<const int32_t> isDifferential) {
+  ToleranceVector result;
+  result.scale = toleranceScales(y0, nominal, isDifferential);
+  double base = atol.value_or(rtol);
+  result.atol.reserve(result.scale.size());
+  for (double scale : result.scale) {
+    double value = base * scale;
+    // Guard against overflow or underflow of the product: IDA rejects a zero or infinite weight.
+    if (!std::isfinite(value) || value <= 0) value = base;
+    result.atol.push_back(value);
+  }
+  ToleranceSummary& s = result.summary;
+  s.rtol = rtol;
+  s.atolUser = base;
+  s.atolGiven = atol.has_value();
+  s.count = result.atol.size();
+  s.automatic =
+      static_cast<std::size_t>(std::count_if(nominal.begin(), nominal.end(), [](double v) { return !hasNominal(v); }));
+  if (!result.atol.empty()) {
+    auto [lo, hi] = std::minmax_element(result.atol.begin(), result.atol.end());
+    s.atolMin = *lo;
+    s.atolMax = *hi;
+    s.atolMedian = median(result.atol);
+  }
+  return result;
+}
+
+}  // namespace qdot::rt

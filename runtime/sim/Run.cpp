@@ -1,0 +1,51 @@
+// runModel: resolve options (UsageError -> exit 2), open the sink, simulate, then print the
+// failure, the warnings and the statistics.
+#include "sim/Run.h"
+
+#include <fmt/format.h>
+
+#include <memory>
+
+#include "output/CsvWriter.h"
+#include "sim/StatsReport.h"
+
+namespace qdot::rt {
+namespace {
+
+void report(const SimulationResult& result, bool stats, std::ostream& log) {
+  for (const std::string& warning : result.warnings)
+    log << "warning: " << warning << '\n';
+  if (!result.success)
+    log << fmt::format("error: the simulation failed at t = {:.10g}: {}\n", result.failureTime, result.message);
+  if (!result.success && result.rows > 0)
+    log << fmt::format("note: the {} rows up to t = {:.10g} were written\n", result.rows, result.lastRowTime);
+  if (stats) log << formatStats(result);
+}
+
+}  // namespace
+
+int runModel(const QdotModel& model, const RunOptions& options, const ExperimentDefaults& experiment,
+             std::ostream& csvOut, std::ostream& log) {
+  ResolvedRun run;
+  try {
+    run = resolveRunOptions(options, experiment, model);
+  } catch (const UsageError& e) {
+    log << "error: " << e.what() << '\n';
+    return kUsageExitCode;
+  } catch (const std::exception& e) {
+    log << "error: " << e.what() << '\n';
+    return kFailureExitCode;
+  }
+  std::unique_ptr<CsvWriter> writer;
+  try {
+    writer = run.outputPath.empty() ? std::make_unique<CsvWriter>(csvOut) : CsvWriter::openFile(run.outputPath);
+  } catch (const std::exception& e) {
+    log << "error: " << e.what() << '\n';
+    return kFailureExitCode;
+  }
+  SimulationResult result = simulate(model, run.settings, *writer);
+  report(result, run.stats, log);
+  return result.success ? 0 : kFailureExitCode;
+}
+
+}  // namespace qdot::rt

@@ -1,0 +1,22 @@
+// runModel: everything `qdot run` and a standalone model executable do after parsing the command
+// line — resolve the options against the model, write the CSV, report failure, warnings and
+// statistics — returning the process exit code.
+#pragma once
+
+#include <ostream>
+
+#include "qdot/model_abi.h"
+#include "sim/RunOptions.h"
+
+namespace qdot::rt {
+
+/// Exit code when the model or the solver failed (usage errors give kUsageExitCode).
+inline constexpr int kFailureExitCode = 1;
+
+/// Runs model with the parsed options. CSV goes to options.outputPath, or to csvOut when it is
+/// empty; errors ("error: ..."), warnings and --stats go to log. Returns 0 on success,
+/// kFailureExitCode when the run failed (rows so far are written), kUsageExitCode for a bad option.
+int runModel(const QdotModel& model, const RunOptions& options, const ExperimentDefaults& experiment,
+             std::ostream& csvOut, std::ostream& log);
+
+}  // namespace qdot::rt

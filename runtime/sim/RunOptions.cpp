@@ -1,0 +1,133 @@
+// Run options: CLI11 registration, defaults from the experiment annotation, validation with
+// clear sentences, and the -p list turned into the parameters() arrays.
+#include "sim/RunOptions.h"
+
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include <charconv>
+#include <cmath>
+#include <stdexcept>
+
+#include "ida/ModelCheck.h"
+
+namespace qdot::rt {
+
+void addRunOptions(CLI::App& app, RunOptions& o) {
+  app.add_option("--start", o.start, "start time (default: experiment annotation, else 0)");
+  app.add_option("--stop", o.stop, "stop time (default: experiment annotation, else 1)");
+  app.add_option("--interval", o.interval, "output interval (default: (stop - start) / 500)");
+  app.add_option("--rtol", o.rtol, "relative tolerance (default: experiment annotation, else 1e-6)");
+  app.add_option("--atol", o.atol, "absolute tolerance, scaled per variable (default: rtol)");
+  app.add_option("-p,--parameter", o.parameters, "set a parameter: -p NAME=VALUE (repeatable)")
+      ->type_name("NAME=VALUE")
+      ->allow_extra_args(false);
+  app.add_option("--outputs", o.outputs, "only these result columns, comma-separated")
+      ->delimiter(',')
+      ->allow_extra_args(false);
+  app.add_option("-o,--output", o.outputPath, "write the CSV results to this file (default: standard output)");
+  app.add_flag("--stats", o.stats, "print solver statistics and timing to standard error");
+  app.add_flag("--invariants", o.invariants, "add the model's invariants (energy, momenta) as columns");
+  app.add_option("--linear-solver", o.linearSolver, "dense, klu or auto (default auto)")
+      ->check(CLI::IsMember({"auto", "dense", "klu"}));
+}
+
+std::optional<double> parseNumber(std::string_view text) {
+  double value = 0;
+  const char* end = text.data() + text.size();
+  auto [stop, ec] = std::from_chars(text.data(), end, value);
+  if (text.empty() || ec != std::errc() || stop != end || !std::isfinite(value)) return std::nullopt;
+  return value;
+}
+
+namespace {
+
+std::size_t parameterIndex(const QdotModel& model, std::string_view name) {
+  auto names = nameList(model.parameterNames, model.nParameters);
+  for (std::size_t i = 0; i < names.size(); ++i)
+    if (names[i] == name) return i;
+  throw UsageError(unknownNameMessage("parameter", name, names));
+}
+
+void requireFinite(std::string_view option, double value) {
+  if (!std::isfinite(value)) throw UsageError(fmt::format("{} must be a finite number", option));
+}
+
+void checkTolerances(double rtol, std::optional<double> atol) {
+  requireFinite("--rtol", rtol);
+  if (rtol <= 0) throw UsageError(fmt::format("--rtol must be positive (got {})", rtol));
+  if (rtol >= 1) throw UsageError(fmt::format("--rtol must be below 1 (got {}); e.g. 1e-6", rtol));
+  if (atol) {
+    requireFinite("--atol", *atol);
+    if (*atol <= 0) throw UsageError(fmt::format("--atol must be positive (got {})", *atol));
+  }
+}
+
+void checkTimes(double start, double stop, double interval) {
+  requireFinite("--start", start);
+  requireFinite("--stop", stop);
+  requireFinite("--interval", interval);
+  if (stop <= start)
+    throw UsageError(fmt::format("the stop time ({}) must be greater than the start time ({})", stop, start));
+  if (interval <= 0) throw UsageError(fmt::format("--interval must be positive (got {})", interval));
+  if (interval > stop - start)
+    throw UsageError(fmt::format("--interval ({}) is longer than the simulated span [{}, {}]", interval, start, stop));
+}
+
+}  // namespace
+
+ParameterOverrides parameterOverrides(const QdotModel& model, const std::vector<std::string>& assignments) {
+  ParameterOverrides result{std::vector<double>(model.nParameters, 0.0), std::vector<uint8_t>(model.nParameters, 0)};
+  std::vector<std::string> givenAs(model.nParameters);
+  for (const std::string& assignment : assignments) {
+    std::size_t eq = assignment.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw UsageError(fmt::format("-p expects NAME=VALUE, got '{}'", assignment));
+    std::string_view name = std::string_view(assignment).substr(0, eq);
+    std::string_view text = std::string_view(assignment).substr(eq + 1);
+    std::size_t i = parameterIndex(model, name);
+    std::optional<double> value = parseNumber(text);
+    if (!value) throw UsageError(fmt::format("the value of parameter '{}' is not a number: '{}'", name, text));
+    if (result.overridden[i])
+      throw UsageError(fmt::format("parameter '{}' is given twice (-p {} and -p {})", name, givenAs[i], assignment));
+    result.given[i] = *value;
+    result.overridden[i] = 1;
+    givenAs[i] = assignment;
+  }
+  return result;
+}
+
+std::vector<double> evaluateParameters(const QdotModel& model, const ParameterOverrides& overrides) {
+  std::vector<double> p(model.nParameters, 0.0);
+  if (model.parameters(&model, overrides.given.data(), overrides.overridden.data(), p.data()) != 0)
+    throw std::runtime_error(fmt::format("the parameter values could not be computed: {}", modelLastError(model)));
+  auto names = nameList(model.parameterNames, model.nParameters);
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (!std::isfinite(p[i])) throw std::runtime_error(fmt::format("parameter '{}' evaluates to {}", names[i], p[i]));
+  return p;
+}
+
+ResolvedRun resolveRunOptions(const RunOptions& o, const ExperimentDefaults& e, const QdotModel& model) {
+  ResolvedRun run;
+  SimulationSettings& s = run.settings;
+  s.start = o.start.value_or(e.start.value_or(0.0));
+  s.stop = o.stop.value_or(e.stop.value_or(kDefaultStop));
+  bool spanChanged = o.start.has_value() || o.stop.has_value();
+  double fallback = (s.stop - s.start) / kDefaultIntervals;
+  s.interval = o.interval.value_or(spanChanged ? fallback : e.interval.value_or(fallback));
+  checkTimes(s.start, s.stop, s.interval);
+  s.rtol = o.rtol.value_or(e.tolerance.value_or(kDefaultRtol));
+  s.atol = o.atol;
+  checkTolerances(s.rtol, s.atol);
+  auto solver = parseLinearSolver(o.linearSolver);
+  if (!solver) throw UsageError(fmt::format("--linear-solver must be dense, klu or auto (got '{}')", o.linearSolver));
+  s.linearSolver = *solver;
+  s.invariants = o.invariants;
+  if (!o.outputs.empty()) s.columns = selectColumns(model, o.outputs, o.invariants);
+  s.parameters = evaluateParameters(model, parameterOverrides(model, o.parameters));
+  run.outputPath = o.outputPath;
+  run.stats = o.stats;
+  return run;
+}
+
+}  // namespace qdot::rt

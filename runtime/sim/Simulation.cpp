@@ -1,0 +1,197 @@
+// simulate(): set up an IdaSession, make the start consistent, then IDASolve (IDA_NORMAL) towards
+// each output time with the stop time set, writing a row after each. Model outputs and invariants
+// are evaluated only when a selected column needs them.
+#include "sim/Simulation.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <set>
+
+#include "ida/ModelCheck.h"
+#include "sim/Names.h"
+
+namespace qdot::rt {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+void appendColumns(std::vector<Column>& columns, Column::Source source, const char* const* names, uint32_t count) {
+  auto list = nameList(names, count);
+  for (uint32_t i = 0; i < count; ++i)
+    columns.push_back({source, i, std::string(list[i])});
+}
+
+/// Evaluates the selected columns at one time: y directly, outputs and invariants via the model.
+class RowBuilder {
+ public:
+  RowBuilder(const QdotModel& model, const std::vector<Column>& columns, std::span<const double> p)
+      : model_(model), columns_(columns), p_(p), values_(columns.size()) {
+    for (const Column& c : columns) {
+      needOutputs_ |= c.source == Column::Source::Output;
+      needInvariants_ |= c.source == Column::Source::Invariant;
+    }
+    outputs_.resize(model.nOutputs);
+    invariants_.resize(model.nInvariants);
+  }
+
+  std::span<const double> build(double t, std::span<const double> y, std::span<const double> yp) {
+    if (needOutputs_) evaluate(model_.outputs, "outputs", t, y, yp, outputs_);
+    if (needInvariants_) evaluate(model_.invariants, "invariants", t, y, yp, invariants_);
+    for (std::size_t i = 0; i < columns_.size(); ++i)
+      values_[i] = value(columns_[i], y);
+    return values_;
+  }
+
+ private:
+  using Function = int (*)(const QdotModel*, double, const double*, const double*, const double*, double*);
+
+  void evaluate(Function f, const char* what, double t, std::span<const double> y, std::span<const double> yp,
+                std::vector<double>& out) {
+    if (f(&model_, t, y.data(), yp.data(), p_.data(), out.data()) != 0)
+      throw IdaError(
+          fmt::format("the model's {} could not be evaluated at t = {:.10g}: {}", what, t, modelLastError(model_)), t);
+  }
+
+  double value(const Column& c, std::span<const double> y) const {
+    switch (c.source) {
+      case Column::Source::Variable:
+        return y[c.index];
+      case Column::Source::Output:
+        return outputs_[c.index];
+      case Column::Source::Invariant:
+        return invariants_[c.index];
+    }
+    return 0;
+  }
+
+  const QdotModel& model_;
+  const std::vector<Column>& columns_;
+  std::span<const double> p_;
+  std::vector<double> values_, outputs_, invariants_;
+  bool needOutputs_ = false, needInvariants_ = false;
+};
+
+SessionOptions sessionOptions(const SimulationSettings& s) {
+  SessionOptions o;
+  o.t0 = s.start;
+  o.rtol = s.rtol;
+  o.atol = s.atol;
+  o.linearSolver = s.linearSolver;
+  o.maxStepsPerOutput = s.maxStepsPerOutput;
+  return o;
+}
+
+void collect(SimulationResult& r, const IdaSession& session) {
+  r.tolerances = session.tolerances();
+  r.linearSolver = session.linearSolver();
+  r.computedInitialValues = session.computedInitialValues();
+  r.warnings = session.warnings();
+  try {
+    r.stats = session.stats();
+  } catch (const IdaError&) {
+    // the counters are informative only
+  }
+}
+
+}  // namespace
+
+std::vector<Column> defaultColumns(const QdotModel& model, bool invariants) {
+  std::vector<Column> columns;
+  appendColumns(columns, Column::Source::Variable, model.variableNames, model.nVariables);
+  appendColumns(columns, Column::Source::Output, model.outputNames, model.nOutputs);
+  if (invariants) appendColumns(columns, Column::Source::Invariant, model.invariantNames, model.nInvariants);
+  return columns;
+}
+
+std::vector<Column> selectColumns(const QdotModel& model, const std::vector<std::string>& names, bool invariants) {
+  std::vector<Column> all = defaultColumns(model, true);
+  std::vector<std::string_view> candidates;
+  for (const Column& c : all)
+    candidates.push_back(c.name);
+  std::vector<Column> chosen;
+  std::set<std::string> seen;
+  for (const std::string& name : names) {
+    auto it = std::find_if(all.begin(), all.end(), [&](const Column& c) { return c.name == name; });
+    if (it == all.end()) throw UsageError(unknownNameMessage("output column", name, candidates));
+    if (!seen.insert(name).second) throw UsageError(fmt::format("output column '{}' is selected twice", name));
+    chosen.push_back(*it);
+  }
+  if (invariants)
+    for (const Column& c : all)
+      if (c.source == Column::Source::Invariant && seen.insert(c.name).second) chosen.push_back(c);
+  return chosen;
+}
+
+OutputGrid::OutputGrid(double start, double stop, double interval)
+    : start_(start), stop_(stop), interval_(interval), regular_(0) {
+  double last = stop - 1e-9 * interval;  // a regular time must lie below this
+  double estimate = std::ceil((last - start) / interval);
+  regular_ = estimate > 0 ? static_cast<std::size_t>(estimate) : 0;
+  while (regular_ > 0 && start + static_cast<double>(regular_ - 1) * interval >= last)
+    --regular_;
+  while (start + static_cast<double>(regular_) * interval < last)
+    ++regular_;
+}
+
+double OutputGrid::operator[](std::size_t k) const {
+  return k < regular_ ? start_ + static_cast<double>(k) * interval_ : stop_;
+}
+
+SimulationResult simulate(const QdotModel& model, const SimulationSettings& settings, ResultSink& sink) {
+  SimulationResult result;
+  result.failureTime = settings.start;
+  result.linearSolverChosenAutomatically = settings.linearSolver == LinearSolverKind::Auto;
+  std::vector<Column> columns =
+      settings.columns.empty() ? defaultColumns(model, settings.invariants) : settings.columns;
+  std::vector<std::string> names;
+  for (const Column& c : columns)
+    names.push_back(c.name);
+  std::unique_ptr<IdaSession> session;
+  Clock::time_point clock = Clock::now();
+  bool solving = false;
+  try {
+    if (!(settings.stop > settings.start) || !(settings.interval > 0))
+      throw IdaError(fmt::format("invalid time span [{}, {}] or interval {}", settings.start, settings.stop,
+                                 settings.interval),
+                     settings.start);
+    OutputGrid grid(settings.start, settings.stop, settings.interval);
+    sink.begin(names);  // the header is written even if the setup fails
+    session = std::make_unique<IdaSession>(model, settings.parameters, sessionOptions(settings));
+    session->initialize(grid[1]);
+    session->setStopTime(settings.stop);
+    result.setupSeconds = secondsSince(clock);
+    clock = Clock::now();
+    solving = true;
+    RowBuilder rows(model, columns, session->parameters());
+    for (std::size_t k = 0; k < grid.size(); ++k) {
+      double t = k == 0 ? session->time() : session->advanceTo(grid[k]);
+      sink.row(t, rows.build(t, session->y(), session->yp()));
+      ++result.rows;
+      result.lastRowTime = t;
+    }
+    result.success = true;
+  } catch (const IdaError& e) {
+    result.failureTime = e.time();
+    result.message = e.what();
+  } catch (const std::exception& e) {  // writing failed, or out of memory
+    result.failureTime = session ? session->time() : settings.start;
+    result.message = e.what();
+  }
+  (solving ? result.solveSeconds : result.setupSeconds) = secondsSince(clock);
+  try {
+    sink.finish();
+  } catch (const std::exception& e) {
+    if (result.success) result.message = e.what();
+    result.success = false;
+  }
+  if (session) collect(result, *session);
+  return result;
+}
+
+}  // namespace qdot::rt

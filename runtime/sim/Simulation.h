@@ -1,0 +1,82 @@
+// The simulation loop: an IdaSession integrated across the output grid, one row per output time
+// written to a ResultSink (time, then the selected columns). Failures become a result with the
+// time and the message; the rows written before a failure stay written.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ida/IdaSession.h"
+#include "output/ResultSink.h"
+#include "qdot/model_abi.h"
+
+namespace qdot::rt {
+
+/// One result column after time: a variable (y), an output definition, or an invariant.
+struct Column {
+  enum class Source { Variable, Output, Invariant };
+  Source source = Source::Variable;
+  uint32_t index = 0;  ///< index within its source
+  std::string name;
+};
+
+/// All variables in model order, then all outputs, then (if invariants) all invariants.
+std::vector<Column> defaultColumns(const QdotModel& model, bool invariants);
+
+/// The named columns (variables, outputs or invariants) in the order given, then, if invariants,
+/// the invariants not named. Throws UsageError for an unknown or repeated name.
+std::vector<Column> selectColumns(const QdotModel& model, const std::vector<std::string>& names, bool invariants);
+
+/// The output times: start + k*interval while below stop (a point closer than 1e-9 intervals to
+/// stop is dropped), then stop itself. Computed on demand, never accumulated.
+class OutputGrid {
+ public:
+  /// Requires stop > start and interval > 0.
+  OutputGrid(double start, double stop, double interval);
+  std::size_t size() const { return regular_ + 1; }  ///< number of output times, stop included
+  double operator[](std::size_t k) const;            ///< the k-th output time
+
+ private:
+  double start_, stop_, interval_;
+  std::size_t regular_;  // number of times start + k*interval before stop
+};
+
+/// Everything one run needs (already validated, see RunOptions).
+struct SimulationSettings {
+  double start = 0;
+  double stop = 1;
+  double interval = 0.002;
+  double rtol = 1e-6;
+  std::optional<double> atol;  ///< user's atol before scaling; none = rtol
+  LinearSolverKind linearSolver = LinearSolverKind::Auto;
+  std::vector<double> parameters;  ///< values from QdotModel::parameters
+  std::vector<Column> columns;     ///< empty = defaultColumns(model, invariants)
+  bool invariants = false;         ///< with empty columns: add the invariant columns
+  long maxStepsPerOutput = 100000;
+};
+
+/// How a run went.
+struct SimulationResult {
+  bool success = false;
+  double failureTime = 0;  ///< when !success: simulation time of the failure
+  std::string message;     ///< when !success: what failed and why
+  std::size_t rows = 0;    ///< rows written (header not counted)
+  double lastRowTime = 0;  ///< time of the last row written
+  SolverStats stats;
+  ToleranceSummary tolerances;
+  LinearSolverKind linearSolver = LinearSolverKind::Auto;  ///< as resolved (Auto if setup failed)
+  bool linearSolverChosenAutomatically = false;            ///< --linear-solver auto
+  bool computedInitialValues = false;
+  std::vector<std::string> warnings;
+  double setupSeconds = 0;  ///< wall time: session setup and consistent initial values
+  double solveSeconds = 0;  ///< wall time: integration and writing
+};
+
+/// Runs the model over the grid, writing into sink (begin, rows, finish). Never throws for
+/// solver or model failures; those are in the result.
+SimulationResult simulate(const QdotModel& model, const SimulationSettings& settings, ResultSink& sink);
+
+}  // namespace qdot::rt

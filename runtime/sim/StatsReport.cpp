@@ -1,0 +1,40 @@
+// formatStats: one line per quantity, labels padded to one column.
+#include "sim/StatsReport.h"
+
+#include <fmt/format.h>
+
+namespace qdot::rt {
+namespace {
+
+void line(std::string& out, std::string_view label, const std::string& value) {
+  out += fmt::format("  {:<22} {}\n", label, value);
+}
+
+std::string toleranceText(const ToleranceSummary& t) {
+  std::string atolSource = t.atolGiven ? fmt::format("atol {:g}", t.atolUser) : "atol = rtol";
+  return fmt::format("rtol {:g}, {} x scale: atol min {:.3g}, median {:.3g}, max {:.3g} ({} of {} scales automatic)",
+                     t.rtol, atolSource, t.atolMin, t.atolMedian, t.atolMax, t.automatic, t.count);
+}
+
+}  // namespace
+
+std::string formatStats(const SimulationResult& r) {
+  const SolverStats& s = r.stats;
+  std::string out = "statistics:\n";
+  line(out, "steps", fmt::format("{} (last step {:.3g}, order {})", s.steps, s.lastStep, s.lastOrder));
+  line(out, "residual evaluations", fmt::format("{}", s.residualEvaluations));
+  line(out, "Jacobian evaluations", fmt::format("{}", s.jacobianEvaluations));
+  line(out, "nonlinear iterations", fmt::format("{}", s.nonlinearIterations));
+  line(out, "error-test failures", fmt::format("{}", s.errorTestFailures));
+  line(out, "convergence failures", fmt::format("{}", s.convergenceFailures));
+  line(out, "linear solver",
+       fmt::format("{} ({})", linearSolverName(r.linearSolver),
+                   r.linearSolverChosenAutomatically ? "chosen automatically" : "as requested"));
+  line(out, "initial values", r.computedInitialValues ? "made consistent by IDACalcIC" : "consistent as given");
+  line(out, "tolerances", toleranceText(r.tolerances));
+  line(out, "rows written", fmt::format("{}", r.rows));
+  line(out, "wall time", fmt::format("setup {:.3f} s, solve {:.3f} s", r.setupSeconds, r.solveSeconds));
+  return out;
+}
+
+}  // namespace qdot::rt

@@ -1,0 +1,87 @@
+// The disassembler (`qdot ... --emit=bytecode`): every function's constants and instructions,
+// one per line with its word offset, and the source an instruction serves whenever it changes.
+// Driven by the opcode table, so a new opcode is printed without touching this file.
+#include <algorithm>
+#include <charconv>
+#include <cstdio>
+#include <ostream>
+
+#include "vm/Vm.h"
+
+namespace qdot::vm {
+namespace {
+
+std::string num(double v) {
+  char buf[32];
+  auto res = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, res.ptr);
+}
+
+std::string reg(uint32_t r) { return std::string("r").append(std::to_string(r)); }
+
+std::string indexName(const bc::Module& m, bc::Opcode op, uint32_t i, const bc::Function& f) {
+  const std::vector<std::string>* names = nullptr;
+  if (op == bc::Opcode::LoadY || op == bc::Opcode::LoadYp) names = &m.variableNames;
+  if (op == bc::Opcode::LoadP || op == bc::Opcode::LoadGiven || op == bc::Opcode::LoadOverridden)
+    names = &m.parameterNames;
+  if (op == bc::Opcode::LoadConst && i < f.constants.size()) return std::to_string(i) + std::string(" (").append(num(f.constants[i])) + ")";
+  return std::to_string(i) + (names && i < names->size() ? std::string(" (").append((*names)[i]) + ")" : "");
+}
+
+std::string operandText(const bc::Module& m, const bc::Function& f, const uint32_t* ip) {
+  auto op = static_cast<bc::Opcode>(*ip);
+  const uint32_t* o = ip + 1;
+  switch (bc::info(op).format) {
+    case bc::Format::End: return "";
+    case bc::Format::None: return reg(o[0]);
+    case bc::Format::Index: return reg(o[0]) + ", " + indexName(m, op, o[1], f);
+    case bc::Format::Unary: return reg(o[0]) + ", " + reg(o[1]);
+    case bc::Format::Binary: return reg(o[0]) + ", " + reg(o[1]) + ", " + reg(o[2]);
+    case bc::Format::Ternary: return reg(o[0]) + ", " + reg(o[1]) + ", " + reg(o[2]) + ", " + reg(o[3]);
+    case bc::Format::UnaryIndex: return reg(o[0]) + ", " + reg(o[1]) + ", " + std::to_string(static_cast<int32_t>(o[2]));
+    case bc::Format::Store: return std::string("out[").append(std::to_string(o[0])) + "], " + reg(o[1]);
+  }
+  return "";
+}
+
+void printSource(std::ostream& os, const bc::Module& m, uint32_t loc) {
+  if (loc >= m.locations.size()) return;
+  const bc::Location& l = m.locations[loc];
+  os << "  ; " << l.label << (l.where.empty() ? "" : " at " + l.where) << (l.text.empty() ? "" : ": " + l.text)
+     << "\n";
+}
+
+}  // namespace
+
+void disassembleFunction(std::ostream& os, const bc::Module& m, bc::FunctionId id) {
+  const bc::Function& f = m.function(id);
+  size_t instructions = f.sources.size();
+  os << "\nfunction " << bc::kFunctionNames[static_cast<int>(id)] << ": " << f.registerCount << " registers ("
+     << f.constants.size() << " constants), " << f.outputCount << " outputs, " << instructions << " instructions, "
+     << f.code.size() << " words\n";
+  for (size_t k = 0; k < f.constants.size(); ++k) os << "  " << reg(k) << " = " << num(f.constants[k]) << "\n";
+  uint32_t source = bc::kNoSource - 1;
+  size_t ordinal = 0;
+  for (size_t pc = 0; pc < f.code.size() && f.code[pc] < bc::kOpcodeCount; ++ordinal) {
+    const uint32_t* ip = &f.code[pc];
+    uint32_t loc = ordinal < f.sources.size() ? f.sources[ordinal] : bc::kNoSource;
+    if (loc != source) printSource(os, m, loc);
+    source = loc;
+    const bc::OpcodeInfo& info = bc::info(static_cast<bc::Opcode>(*ip));
+    char offset[16];
+    std::snprintf(offset, sizeof offset, "%04zu", pc);
+    std::string ops = operandText(m, f, ip), name = info.mnemonic;
+    if (!ops.empty()) name.resize(std::max<size_t>(name.size() + 1, 8), ' ');
+    os << "  " << offset << "  " << name << ops << "\n";
+    pc += 1 + bc::operandCount(info.format);
+  }
+}
+
+void disassemble(std::ostream& os, const bc::Module& m) {
+  os << "bytecode " << m.name << " (format " << bc::kFormatVersion << "): " << m.variableNames.size()
+     << " variables, " << m.parameterNames.size() << " parameters, " << m.outputNames.size() << " outputs, "
+     << m.invariantNames.size() << " invariants, " << m.jacobianRowIndices.size() << " Jacobian nonzeros\n";
+  for (uint32_t f = 0; f < bc::kFunctionCount; ++f) disassembleFunction(os, m, static_cast<bc::FunctionId>(f));
+}
+
+}  // namespace qdot::vm

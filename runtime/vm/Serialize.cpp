@@ -1,0 +1,155 @@
+// bc::serialize / bc::deserialize: a little-endian byte image of a Module (magic "QDBC", format
+// version, then the fields in declaration order; vectors and strings are prefixed by a u32 count).
+// Reading checks every length against the bytes left and validates the result.
+#include <bit>
+#include <cstring>
+
+#include "qdot/bytecode.h"
+
+namespace qdot::bc {
+namespace {
+
+constexpr uint8_t kMagic[4] = {'Q', 'D', 'B', 'C'};
+
+class Writer {
+ public:
+  void u32(uint32_t v) {
+    for (int i = 0; i < 4; ++i) bytes.push_back(static_cast<uint8_t>(v >> (8 * i)));
+  }
+  void f64(double d) {
+    auto v = std::bit_cast<uint64_t>(d);
+    for (int i = 0; i < 8; ++i) bytes.push_back(static_cast<uint8_t>(v >> (8 * i)));
+  }
+  void str(const std::string& s) {
+    u32(static_cast<uint32_t>(s.size()));
+    bytes.insert(bytes.end(), s.begin(), s.end());
+  }
+  void strings(const std::vector<std::string>& v) {
+    u32(static_cast<uint32_t>(v.size()));
+    for (const auto& s : v) str(s);
+  }
+  template <class T> void words(const std::vector<T>& v) {
+    u32(static_cast<uint32_t>(v.size()));
+    for (T x : v) u32(static_cast<uint32_t>(x));
+  }
+  std::vector<uint8_t> bytes;
+};
+
+class Reader {
+ public:
+  explicit Reader(std::span<const uint8_t> b) : b_(b) {}
+  bool ok() const { return ok_; }
+  bool atEnd() const { return pos_ == b_.size(); }
+
+  uint32_t u32() {
+    if (!need(4)) return 0;
+    uint32_t v = 0;
+    for (int i = 0; i < 4; ++i) v |= static_cast<uint32_t>(b_[pos_++]) << (8 * i);
+    return v;
+  }
+  double f64() {
+    if (!need(8)) return 0;
+    uint64_t v = 0;
+    for (int i = 0; i < 8; ++i) v |= static_cast<uint64_t>(b_[pos_++]) << (8 * i);
+    return std::bit_cast<double>(v);
+  }
+  std::string str() {
+    uint32_t n = u32();
+    if (!need(n)) return {};
+    std::string s(reinterpret_cast<const char*>(b_.data() + pos_), n);
+    pos_ += n;
+    return s;
+  }
+  // A count of elements each at least `minBytes` long (so a bad count cannot allocate wildly).
+  uint32_t count(size_t minBytes) {
+    uint32_t n = u32();
+    return need(static_cast<size_t>(n) * minBytes, false) ? n : (ok_ = false, 0);
+  }
+  std::vector<std::string> strings() {
+    std::vector<std::string> v(count(4));
+    for (auto& s : v) s = str();
+    return v;
+  }
+  template <class T> std::vector<T> words() {
+    std::vector<T> v(count(4));
+    for (auto& x : v) x = static_cast<T>(u32());
+    return v;
+  }
+
+ private:
+  bool need(size_t n, bool fail = true) {
+    if (ok_ && b_.size() - pos_ >= n) return true;
+    if (fail) ok_ = false;
+    return false;
+  }
+  std::span<const uint8_t> b_;
+  size_t pos_ = 0;
+  bool ok_ = true;
+};
+
+void writeFunction(Writer& w, const Function& f) {
+  w.u32(f.registerCount);
+  w.u32(f.outputCount);
+  w.u32(static_cast<uint32_t>(f.constants.size()));
+  for (double c : f.constants) w.f64(c);
+  w.words(f.code);
+  w.words(f.sources);
+}
+
+Function readFunction(Reader& r) {
+  Function f;
+  f.registerCount = r.u32();
+  f.outputCount = r.u32();
+  f.constants.resize(r.count(8));
+  for (double& c : f.constants) c = r.f64();
+  f.code = r.words<uint32_t>();
+  f.sources = r.words<uint32_t>();
+  return f;
+}
+
+}  // namespace
+
+std::vector<uint8_t> serialize(const Module& m) {
+  Writer w;
+  w.bytes.assign(kMagic, kMagic + 4);
+  w.u32(kFormatVersion);
+  w.str(m.name);
+  for (const auto* names : {&m.variableNames, &m.parameterNames, &m.parameterDescriptions, &m.outputNames,
+                            &m.invariantNames})
+    w.strings(*names);
+  for (const auto* ints : {&m.isDifferential, &m.fixed, &m.jacobianColumnStarts, &m.jacobianRowIndices})
+    w.words(*ints);
+  for (const Function& f : m.functions) writeFunction(w, f);
+  w.u32(static_cast<uint32_t>(m.locations.size()));
+  for (const Location& l : m.locations) w.str(l.label), w.str(l.where), w.str(l.text);
+  return std::move(w.bytes);
+}
+
+bool deserialize(std::span<const uint8_t> bytes, Module& m, std::string& error) {
+  if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 4) != 0) {
+    error = "not qdot bytecode (no QDBC header)";
+    return false;
+  }
+  Reader r(bytes.subspan(4));
+  if (uint32_t version = r.u32(); version != kFormatVersion) {
+    error = "bytecode format version " + std::to_string(version) + ", expected " + std::to_string(kFormatVersion);
+    return false;
+  }
+  m = Module();
+  m.name = r.str();
+  for (auto* names : {&m.variableNames, &m.parameterNames, &m.parameterDescriptions, &m.outputNames,
+                      &m.invariantNames})
+    *names = r.strings();
+  for (auto* ints : {&m.isDifferential, &m.fixed, &m.jacobianColumnStarts, &m.jacobianRowIndices})
+    *ints = r.words<int32_t>();
+  for (Function& f : m.functions) f = readFunction(r);
+  m.locations.resize(r.count(12));
+  for (Location& l : m.locations) l.label = r.str(), l.where = r.str(), l.text = r.str();
+  if (!r.ok() || !r.atEnd()) {
+    error = r.ok() ? "trailing bytes after the bytecode module" : "truncated bytecode module";
+    return false;
+  }
+  return validate(m, error);
+}
+
+}  // namespace qdot::bc

@@ -1,0 +1,126 @@
+// The per-variable absolute tolerance vector: the scale rule on small hand-made vectors, what a
+// session really hands to IDA, and why it matters (a variable of size 1e-8 stays accurate).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "HandModels.h"
+#include "ida/IdaSession.h"
+#include "ida/Tolerances.h"
+#include "sim/Simulation.h"
+
+namespace qdot::rt::test {
+namespace {
+
+TEST(ToleranceScales, NominalWinsElseStartValueWithAFloorPerKind) {
+  // differential: 2, 0, -50 (nominal 0.1 on the second); algebraic: 0, 400
+  std::vector<double> y0 = {2, 0, -50, 0, 400};
+  std::vector<double> nominal = {0, 0.1, 0, 0, 0};
+  std::vector<int32_t> kind = {1, 1, 1, 0, 0};
+  std::vector<double> s = toleranceScales(y0, nominal, kind);
+  EXPECT_EQ(s[0], 2.0);         // |y0|
+  EXPECT_EQ(s[1], 0.1);         // nominal
+  EXPECT_EQ(s[2], 50.0);        // |y0|
+  EXPECT_DOUBLE_EQ(s[3], 0.4);  // floor: 1e-3 * largest algebraic (400)
+  EXPECT_EQ(s[4], 400.0);
+}
+
+TEST(ToleranceScales, ZeroKindFallsBackToAllThenToOne) {
+  std::vector<int32_t> kind = {1, 0, 0};
+  // algebraic all zero: floor from the largest of all (5)
+  EXPECT_DOUBLE_EQ(toleranceScales(std::vector<double>{5, 0, 0}, std::vector<double>(3, 0.0), kind)[1], 5e-3);
+  // algebraic values at roundoff level (1e-30 after IDACalcIC) are negligible: same fallback
+  EXPECT_DOUBLE_EQ(toleranceScales(std::vector<double>{5, 1e-30, 0}, std::vector<double>(3, 0.0), kind)[1], 5e-3);
+  // everything zero: unit scale
+  std::vector<double> zeros(3, 0.0);
+  EXPECT_EQ(toleranceScales(zeros, zeros, kind), (std::vector<double>{1, 1, 1}));
+  // a NaN start counts as 0, a negative or NaN nominal as none
+  std::vector<double> s = toleranceScales(std::vector<double>{NAN, 3, 0}, std::vector<double>{-1, NAN, 0}, kind);
+  EXPECT_DOUBLE_EQ(s[0], 3e-3);  // its kind (differential) is all zero: 1e-3 * largest of all (3)
+  EXPECT_EQ(s[1], 3.0);          // NaN nominal ignored, |y0| used
+  EXPECT_DOUBLE_EQ(s[2], 3e-3);  // 1e-3 * largest algebraic (3)
+}
+
+TEST(ToleranceVector, AtolIsUserAtolTimesScaleAndDefaultsToRtol) {
+  std::vector<double> y0 = {1e-8, 3, 0};
+  std::vector<double> nominal = {0, 0, 0};
+  std::vector<int32_t> kind = {1, 1, 1};
+  ToleranceVector v = buildTolerances(1e-6, std::nullopt, y0, nominal, kind);
+  ASSERT_EQ(v.atol.size(), 3u);
+  EXPECT_DOUBLE_EQ(v.atol[0], 1e-6 * 3e-3);  // floor 1e-3 * 3 beats |1e-8|
+  EXPECT_DOUBLE_EQ(v.atol[1], 1e-6 * 3);
+  EXPECT_DOUBLE_EQ(v.atol[2], 1e-6 * 3e-3);
+  EXPECT_FALSE(v.summary.atolGiven);
+  EXPECT_EQ(v.summary.atolUser, 1e-6);
+  EXPECT_EQ(v.summary.automatic, 3u);
+  EXPECT_DOUBLE_EQ(v.summary.atolMin, 3e-9);
+  EXPECT_DOUBLE_EQ(v.summary.atolMedian, 3e-9);
+  EXPECT_DOUBLE_EQ(v.summary.atolMax, 3e-6);
+
+  nominal = {1e-8, 0, 0};
+  ToleranceVector w = buildTolerances(1e-6, 1e-4, y0, nominal, kind);
+  EXPECT_DOUBLE_EQ(w.atol[0], 1e-4 * 1e-8);
+  EXPECT_DOUBLE_EQ(w.atol[1], 1e-4 * 3);
+  EXPECT_TRUE(w.summary.atolGiven);
+  EXPECT_EQ(w.summary.automatic, 2u);
+  EXPECT_DOUBLE_EQ(w.summary.atolMedian, 3e-7);  // {1e-12, 3e-7, 3e-4}
+}
+
+TEST(ToleranceVector, MedianOfAnEvenCountIsTheMeanOfTheMiddleTwo) {
+  std::vector<double> y0 = {1, 2, 4, 8};
+  std::vector<int32_t> kind(4, 1);
+  ToleranceVector v = buildTolerances(1.0, std::nullopt, y0, std::vector<double>(4, 0.0), kind);
+  EXPECT_DOUBLE_EQ(v.summary.atolMedian, 3.0);
+}
+
+TEST(ToleranceVector, TheSessionUsesNominalAndConsistentValues) {
+  // Bernoulli DAE: y2 starts at 0 but IDACalcIC makes it 1/2; the automatic scale follows.
+  HandModel dae = bernoulliDae();
+  SessionOptions o;
+  o.rtol = 1e-6;
+  IdaSession session(dae.abi(), {}, o);
+  session.initialize(0.1);
+  ASSERT_EQ(session.absoluteTolerances().size(), 2u);
+  EXPECT_DOUBLE_EQ(session.absoluteTolerances()[0], 1e-6);    // |y1(0)| = 1
+  EXPECT_DOUBLE_EQ(session.absoluteTolerances()[1], 0.5e-6);  // |y2(0)| = 1/2 after CalcIC
+  // Robertson: nominal 1e-5 on y2 gives atol 1e-5 * rtol there.
+  HandModel rob = robertson();
+  IdaSession second(rob.abi(), {}, o);
+  EXPECT_DOUBLE_EQ(second.absoluteTolerances()[1], 1e-11);
+  EXPECT_EQ(second.tolerances().automatic, 2u);
+}
+
+// Reference: x = 1e-8 exp(-t) (x' = -x). With one scalar atol = rtol = 1e-6 the error test would
+// accept anything for a variable of size 1e-8; the scaled atol (1e-6 * 1e-8) keeps it accurate
+// to a relative 1e-4.
+TEST(ToleranceVector, TinyVariableStaysAccurate) {
+  HandModel m;
+  m.variables = {"x"};
+  m.differential = {1};
+  m.start = {1e-8};
+  m.entries = {{0, 0}};
+  m.residual = [](double, const double* y, const double* yp, const double*, double* F) {
+    F[0] = yp[0] + y[0];
+    return 0;
+  };
+  m.jacobian = [](double, const double*, const double*, const double*, double cj, JacobianValues& J) {
+    J(0, 0) = cj + 1;
+    return 0;
+  };
+  SimulationSettings s;
+  s.stop = 5;
+  s.interval = 0.5;
+  MemorySink sink;
+  SimulationResult r = simulate(m.abi(), s, sink);
+  ASSERT_TRUE(r.success) << r.message;
+  double worst = 0;
+  for (std::size_t k = 0; k < sink.rows.size(); ++k) {
+    double exact = 1e-8 * std::exp(-sink.times[k]);
+    worst = std::max(worst, std::abs(sink.rows[k][0] - exact) / exact);
+  }
+  std::printf("  x = 1e-8 exp(-t), rtol 1e-6: max relative error %.3g\n", worst);
+  EXPECT_LT(worst, 1e-4);
+}
+
+}  // namespace
+}  // namespace qdot::rt::test
