@@ -1,8 +1,7 @@
-// emitFunction: linear-scan register assignment over the kernel's SSA program (it is straight-line
-// code, so a value's live range ends at its last use). Operands whose last use is an instruction
-// are released before its result is assigned, so the result may reuse an operand's register
-// (every VM handler reads its operands first). `ldk` emits nothing: constants live in registers
-// [0, pool size), preloaded once by the VM.
+// emitFunction: linear-scan register assignment over the kernel's straight-line SSA program.
+// Operands dying at an instruction are released before its result is assigned, so the result may
+// reuse an operand's register (VM handlers read operands first). `ldk` emits nothing: constants
+// live in registers [0, pool size), preloaded once by the VM.
 #include "bytecode/Emitter.h"
 
 #include "vm/Vm.h"

@@ -28,8 +28,9 @@ const UnaryMath kUnaryMath[] = {
 // d/dt with one memo for the whole model. A symbol's rate is asked once, when a derivative first
 // reaches it: time → 1, parameters (and non-variables) → 0, any other variable → its der() variable,
 // created on demand (an error at `where` if it cannot have one; it is then asked again next time).
+// The rate function is re-bound on each call so that error carries this call's location.
 Expr Flattener::timeDerivative(Expr e, SourceRange where) {
-  timeDerivative_.setRateFunction([this, &where](Expr s) {
+  timeDerivative_.setRateFunction([this, where](Expr s) {
     int var = out_.variableOf(s);
     if (var < 0 || out_.variables[var].role == VarRole::Parameter) return ctx_.zero();
     if (out_.variables[var].role == VarRole::Time) return ctx_.one();

@@ -214,7 +214,7 @@ class Builder {
     for (size_t j = 0; j < dae_.variables.size(); ++j) {
       const auto& v = dae_.variables[j];
       starts[j].y0 = v.start;
-      starts[j].source = addSource("start value of " + v.name, v.declRange);
+      if (v.start) starts[j].source = addSource("start value of " + v.name, v.declRange);
     }
     for (size_t i = 0; i < dae_.initialEquations.size(); ++i)
       if (!applyInitialEquation(i, starts))
@@ -225,24 +225,21 @@ class Builder {
     return starts;
   }
 
-  // out = [y0 (n), yp0 (n), nominal (n)].
+  // out = [y0 (n), yp0 (n), nominal (n)]; stores of a plain 0 serve no source.
   void buildInitialValues() {
     std::vector<Start> starts = collectStarts();
     ProgramBuilder b("initialValues");
     bindInputs(b, false);
     auto n = static_cast<uint32_t>(dae_.variables.size());
+    auto store = [&](uint32_t slot, Expr value, uint32_t source) {
+      b.setSource(value ? source : UINT32_MAX);
+      b.store(slot, value ? b.lower(value) : b.constant(0.0));
+    };
+    for (uint32_t j = 0; j < n; ++j) store(j, starts[j].y0, starts[j].source);
+    for (uint32_t j = 0; j < n; ++j) store(n + j, starts[j].yp0, starts[j].derivativeSource);
     for (uint32_t j = 0; j < n; ++j) {
-      b.setSource(starts[j].source);
-      b.store(j, starts[j].y0 ? b.lower(starts[j].y0) : b.constant(0.0));
-    }
-    for (uint32_t j = 0; j < n; ++j) {
-      b.setSource(starts[j].derivativeSource == UINT32_MAX ? starts[j].source : starts[j].derivativeSource);
-      b.store(n + j, starts[j].yp0 ? b.lower(starts[j].yp0) : b.constant(0.0));
-    }
-    for (uint32_t j = 0; j < n; ++j) {
-      b.setSource(starts[j].source);
-      Expr nominal = dae_.variables[j].nominal;
-      b.store(2 * n + j, nominal ? b.lower(nominal) : b.constant(0.0));
+      const auto& v = dae_.variables[j];
+      store(2 * n + j, v.nominal, v.nominal ? addSource("nominal value of " + v.name, v.declRange) : UINT32_MAX);
     }
     reportUnbound(b, "start values (only parameters may be used)");
     m_.program(ProgramId::InitialValues) = b.finish(3 * n);

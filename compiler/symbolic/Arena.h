@@ -16,6 +16,19 @@
 #include <sys/mman.h>
 #endif
 
+// Under AddressSanitizer, unused arena memory is poisoned and allocations are separated by
+// redzones, so an overflow from one node's operands into the next is still reported.
+#if defined(__SANITIZE_ADDRESS__)
+#define QDOT_ARENA_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define QDOT_ARENA_ASAN 1
+#endif
+#endif
+#ifdef QDOT_ARENA_ASAN
+#include <sanitizer/asan_interface.h>
+#endif
+
 namespace qdot::sym {
 
 /// Asks the OS to back the 2 MiB-aligned part of [p, p + bytes) with huge pages. Call it before the
@@ -53,12 +66,15 @@ class Arena {
   /// Uninitialised storage of `size` bytes aligned to `align` (a power of two).
   void* allocateBytes(size_t size, size_t align) {
     size_t pad = (align - reinterpret_cast<uintptr_t>(next_) % align) % align;
-    if (size + pad > static_cast<size_t>(end_ - next_)) {
-      newChunk(size + align);
+    if (size + pad + kRedzone > static_cast<size_t>(end_ - next_)) {
+      newChunk(size + align + kRedzone);
       pad = (align - reinterpret_cast<uintptr_t>(next_) % align) % align;
     }
-    void* p = next_ + pad;
-    next_ += pad + size;
+    std::byte* p = next_ + pad;
+    next_ += pad + size + kRedzone;
+#ifdef QDOT_ARENA_ASAN
+    ASAN_UNPOISON_MEMORY_REGION(p, size);
+#endif
     return p;
   }
 
@@ -70,7 +86,16 @@ class Arena {
     next_ = chunks_.back().get();
     end_ = next_ + size;
     reserved_ += size;
+#ifdef QDOT_ARENA_ASAN
+    ASAN_POISON_MEMORY_REGION(next_, size);
+#endif
   }
+
+#ifdef QDOT_ARENA_ASAN
+  static constexpr size_t kRedzone = 16;
+#else
+  static constexpr size_t kRedzone = 0;
+#endif
 
   std::vector<std::unique_ptr<std::byte[]>> chunks_;
   std::byte* next_ = nullptr;

@@ -51,17 +51,17 @@ void computeDerived(Node& n) {
   for (Expr a : n.args) {
     h = mix(h, a->hash);
     mask |= a->symbolMask;
-    depth = std::max(depth, a->depth + 1);
+    depth = std::max<uint32_t>(depth, a->depth + 1);
   }
   for (double c : n.coefs) h = mix(h, numberBits(c));
   for (Expr e : n.exps) {
     h = mix(h, e->hash);
     mask |= e->symbolMask;
-    depth = std::max(depth, e->depth + 1);
+    depth = std::max<uint32_t>(depth, e->depth + 1);
   }
   n.hash = h;
   n.symbolMask = mask;
-  n.depth = depth;
+  n.depth = std::min(depth, Node::kMaxDepth);
 }
 
 template <class T>
@@ -93,7 +93,7 @@ Expr Context::Impl::intern(Node& key) {
 // cache lines for a small node): children in one array (args, then exps), then the coefficients.
 Expr Context::Impl::store(const Node& key) {
   size_t nArgs = key.args.size(), nKids = nArgs + key.exps.size(), nCoefs = key.coefs.size();
-  static_assert(std::is_trivially_destructible_v<Node> && sizeof(Node) % alignof(Expr) == 0 &&
+  static_assert(std::is_trivially_destructible_v<Node> && sizeof(Node) == 80 && sizeof(Node) % alignof(Expr) == 0 &&
                 alignof(Expr) == alignof(double) && alignof(Node) >= alignof(Expr));
   void* bytes = arena.allocateBytes(sizeof(Node) + nKids * sizeof(Expr) + nCoefs * sizeof(double), alignof(Node));
   Node* n = new (bytes) Node(key);
@@ -147,7 +147,7 @@ Context::~Context() = default;
 Expr Context::constant(double v) {
   v = normalizeNumber(v);
   uint64_t bits = numberBits(v);
-  auto& slot = impl_->recentConstants[(bits * 0x9E3779B97F4A7C15ull) >> 54];
+  auto& slot = impl_->recentConstants[(bits * 0x9E3779B97F4A7C15ull) >> (64 - Impl::kConstantCacheBits)];
   if (slot.node && slot.bits == bits) return slot.node;
   Node n{};
   n.kind = Kind::Constant;

@@ -103,7 +103,9 @@ struct Context::Impl {
     uint64_t bits = 0;
     Expr node = nullptr;
   };
-  std::vector<ConstantSlot> recentConstants = std::vector<ConstantSlot>(1024);  ///< direct-mapped cache
+  static constexpr int kConstantCacheBits = 10;
+  /// Direct-mapped cache of recent constants, indexed by a hash of the value's bits.
+  std::vector<ConstantSlot> recentConstants = std::vector<ConstantSlot>(size_t{1} << kConstantCacheBits);
   std::deque<std::string> symbolNames;  ///< by symbolId (deque keeps references stable)
   std::vector<Expr> symbols;            ///< by symbolId
   struct NameSlot {

@@ -37,7 +37,7 @@ Expr minusOne(Expr e, Context& ctx) {
   return e->isConstant() ? ctx.constant(e->value - 1.0) : ctx.sub(e, ctx.one());
 }
 
-// d(b^e) = e*b^(e-1)*db + b^e*log(b)*de; only the first term when e does not depend on s.
+// d(b^e) = e*b^(e-1)*db + b^e*log(b)*de; only the first term when e does not move.
 // `self` is b^e (the Pow node, or nullptr to build it when needed).
 Expr powRule(const Diff& D, Expr b, Expr e, Expr self) {
   Context& ctx = D.ctx;

@@ -59,9 +59,10 @@ using Expr = const Node*;
 /// The operand spans point into the Context's arena (a Mul's exps directly follow its args) and
 /// live as long as the Context; nodes are trivially destructible.
 struct Node {
+  static constexpr uint32_t kMaxDepth = (1u << 24) - 1;
   Kind kind;
+  uint32_t depth : 24 = 0;  ///< longest path to a leaf (leaves 0), saturating at kMaxDepth
   uint32_t symbolId = 0;
-  uint32_t depth = 0;       ///< longest path to a leaf (leaves 0)
   uint64_t hash = 0;
   uint64_t symbolMask = 0;  ///< bit (id % 64) set for every symbol below; 0 => constant expression
   double value = 0;

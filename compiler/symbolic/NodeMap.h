@@ -1,6 +1,7 @@
 // NodeMap<V>: a small open-addressing hash map keyed by node pointer, used for per-call memos
 // (evaluation tapes, substitute, CSE) and the per-symbol derivative memo. Linear probing,
-// power-of-two capacity, no erase (only clear); an empty map allocates nothing.
+// power-of-two capacity from 4 (many memos stay tiny), no erase (only clear); an empty map
+// allocates nothing.
 // NodeSet: the visited set of one traversal; a linear scan of an inline array while small.
 #pragma once
 
@@ -57,7 +58,7 @@ class NodeMap {
     return static_cast<size_t>(h ^ (h >> 33)) & mask();
   }
   void grow() {
-    std::vector<std::pair<Expr, V>> old(slots_.empty() ? 16 : slots_.size() * 2);
+    std::vector<std::pair<Expr, V>> old(slots_.empty() ? 4 : slots_.size() * 2);
     old.swap(slots_);
     size_ = 0;
     for (auto& s : old)

@@ -243,7 +243,8 @@ ExprPtr Parser::parsePowerOperand() {
 }
 
 /// postfix := primary {array_subscripts | "." IDENT | function_call_args}
-/// (a dotted name without subscripts stays one NameExpr; only a name can be called)
+/// (a dotted name without subscripts stays one NameExpr; only a name can be called; only a name
+///  or a subscripted/member expression can have a `.field`)
 ExprPtr Parser::parsePostfix() {
   uint32_t begin = tok().range.begin;
   bool plainName = false;
@@ -255,6 +256,10 @@ ExprPtr Parser::parsePostfix() {
       e = parseSubscripts(std::move(e), begin);
       plainName = false;
     } else if (at(TokenKind::dot)) {
+      if (!plainName && !ast::isa<ast::IndexExpr>(e.get()) && !ast::isa<ast::MemberExpr>(e.get())) {
+        failNotComponent(*e);  // 5.0.x, (a + b).x, f(x).y
+        break;
+      }
       take();
       if (!at(TokenKind::identifier)) {
         failExpected("a name after '.'", "E0116");
@@ -283,6 +288,11 @@ ExprPtr Parser::parsePostfix() {
     }
   }
   return e;
+}
+
+[[gnu::noinline]] void Parser::failNotComponent(const ast::Expr& e) {
+  fail(tok().range, "E0118", "only a component can have members, not " + quote(sm_.slice(e.range)),
+       "member access looks like a.b or ms[2].a");
 }
 
 [[gnu::noinline]] void Parser::failNotCallable(const ast::Expr& e) {

@@ -183,6 +183,7 @@ class Parser {
   ExprPtr makeBinary(ast::BinaryOp op, SourceRange opRange, ExprPtr lhs, ExprPtr rhs, uint32_t begin);
   void reportChainedPower(const ast::BinaryExpr& first, const ast::Expr* third, SourceRange at);
   void failNotCallable(const ast::Expr& e);
+  void failNotComponent(const ast::Expr& e);
   ExprPtr failKeywordCall(std::string_view keyword);
   ExprPtr unexpectedInExpression();
   bool canStartExpression();

@@ -11,7 +11,7 @@
 namespace qdot::rt {
 
 /// Exit code when the model or the solver failed (usage errors give kUsageExitCode).
-inline constexpr int kFailureExitCode = 1;
+inline constexpr int kFailureExitCode = 3;
 
 /// Runs model with the parsed options. CSV goes to options.outputPath, or to csvOut when it is
 /// empty; errors ("error: ..."), warnings and --stats go to log. Returns 0 on success,

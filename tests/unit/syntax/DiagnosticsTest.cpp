@@ -96,6 +96,10 @@ const BadInput kBadInputs[] = {
      "must be the only argument", ""},
     {"calling a subscripted name", "model M\n  Real x = y[1](2);\nend M;\n", "2:16", "E0118",
      "only a name can be called, not 'y[1]'", ""},
+    // Found by fuzz_frontend: a member of a number printed back as `5.rho`, which lexes differently.
+    {"member of a number", "model M\n  Real x = 5.0.rho;\nend M;\n", "2:15", "E0118",
+     "only a component can have members, not '5.0'", "a.b"},
+    {"member of a call", "model M\n  Real x = f(1).y;\nend M;\n", "2:16", "E0118", "not 'f(1)'", ""},
     {"der without parentheses", "model M\nequation\n  der x = 1;\nend M;\n", "3:7", "E0117",
      "expected '(' after 'der', found identifier 'x'", ""},
     {"double equals in an equation", "model M\nequation\n  x == 1;\nend M;\n", "3:9", "E0117",

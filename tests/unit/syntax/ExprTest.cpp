@@ -178,6 +178,16 @@ TEST(ToSource, RoundTrips) {
   }
 }
 
+// Regression (fuzz_frontend): postfix forms on literals print back to text that lexes the same.
+TEST(ToSource, PostfixOnLiteralsRoundTrips) {
+  for (const char* c : {"(1)[2]", "(1.5)[2]", "{1, 2}[1]", "\"s\"[1]", "(1)[2].a", "(1:3)[2]"}) {
+    auto p = parseText(std::string("model M Real v = ") + c + "; end M;");
+    ASSERT_FALSE(p->diags.hasErrors()) << c << "\n" << p->rendered();
+    std::string printed = toSource(*p->cls().declarations[0].binding);
+    EXPECT_EQ(exprShape(printed), sexpr(p->cls().declarations[0].binding.get())) << c << " -> " << printed;
+  }
+}
+
 TEST(ToSource, NormalisesSpacingAndNumbers) {
   auto p = parseText("model M Real v = 0.50*rho  +x^ 2-1e-4; end M;");
   EXPECT_EQ(toSource(*p->cls().declarations[0].binding), "0.5*rho + x^2 - 0.0001");

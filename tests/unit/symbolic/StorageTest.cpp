@@ -1,0 +1,132 @@
+// The storage and fast paths behind the public API give the same answers as the plain algorithms:
+// large sums built from ascending runs, reversed or shuffled operands are one node; the constant
+// cache and the symbol-name table never confuse values or names; traversals agree below and above
+// the size where their visited set leaves its inline buffer; operands of a Mul are contiguous.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <set>
+
+#include "symbolic/Expr.h"
+
+using namespace qdot::sym;
+
+namespace {
+
+std::string numbered(const char* prefix, size_t i) {
+  std::string name = prefix;
+  name += std::to_string(i);
+  return name;
+}
+
+// Mixed terms: symbols, products, powers and functions, with repeated (like) terms.
+std::vector<Expr> mixedTerms(Context& ctx, size_t n) {
+  std::vector<Expr> q, terms;
+  for (size_t i = 0; i < n / 4 + 1; ++i) q.push_back(ctx.symbol(numbered("q", i)));
+  for (size_t i = 0; i < n; ++i) {
+    Expr a = q[i % q.size()], b = q[(7 * i + 3) % q.size()];
+    switch (i % 4) {
+      case 0: terms.push_back(ctx.scale(double(i % 5) + 1, a)); break;
+      case 1: terms.push_back(ctx.mul(a, b)); break;
+      case 2: terms.push_back(ctx.pow(a, ctx.constant(double(i % 3) + 2))); break;
+      default: terms.push_back(ctx.unary(Kind::Sin, ctx.add(a, b))); break;
+    }
+  }
+  return terms;
+}
+
+TEST(Storage, LargeSumsDoNotDependOnOperandOrder) {
+  for (size_t n : {10u, 63u, 64u, 65u, 200u, 5000u}) {
+    Context ctx;
+    std::vector<Expr> terms = mixedTerms(ctx, n);
+    Expr sum = ctx.add(terms);
+    std::vector<Expr> reversed(terms.rbegin(), terms.rend());
+    EXPECT_EQ(ctx.add(reversed), sum) << n;
+    std::vector<Expr> shuffled = terms;
+    std::shuffle(shuffled.begin(), shuffled.end(), std::mt19937(static_cast<unsigned>(n)));
+    EXPECT_EQ(ctx.add(shuffled), sum) << n;
+    // Sorted runs: two canonical halves, and a canonical sum plus a few stray terms.
+    size_t half = n / 2;
+    Expr a = ctx.add(std::span<const Expr>(terms).first(half));
+    Expr b = ctx.add(std::span<const Expr>(terms).subspan(half));
+    EXPECT_EQ(ctx.add(a, b), sum) << n;
+    Expr most = ctx.add(std::span<const Expr>(terms).first(n - 3));
+    std::vector<Expr> parts = {terms[n - 1], most, terms[n - 3], terms[n - 2]};
+    EXPECT_EQ(ctx.add(parts), sum) << n;
+    if (sum->kind == Kind::Add) {
+      for (size_t i = 1; i < sum->args.size(); ++i) EXPECT_LT(structuralCompare(sum->args[i - 1], sum->args[i]), 0);
+    }
+  }
+}
+
+TEST(Storage, ConstantsAreExactAndUnique) {
+  Context ctx;
+  std::mt19937_64 rng(7);
+  std::vector<double> values = {0.0, 1.0, -1.0, 0.5, 1e-300, -1e300, std::numeric_limits<double>::infinity()};
+  for (int i = 0; i < 20000; ++i) values.push_back(std::ldexp(double(rng() % 100000) - 50000, int(rng() % 40) - 20));
+  std::set<Expr> distinct;
+  for (double v : values) {
+    Expr c = ctx.constant(v);
+    ASSERT_EQ(c->value, v);
+    ASSERT_EQ(ctx.constant(v), c);  // cached or not, the same node
+    distinct.insert(c);
+  }
+  EXPECT_EQ(distinct.size(), std::set<double>(values.begin(), values.end()).size());
+  EXPECT_EQ(ctx.constant(-0.0), ctx.zero());
+  Expr nan = ctx.constant(std::numeric_limits<double>::quiet_NaN());
+  EXPECT_EQ(ctx.constant(-std::numeric_limits<double>::quiet_NaN()), nan);
+}
+
+TEST(Storage, ManySymbolsWithLongNames) {
+  Context ctx;
+  const size_t N = 20000;
+  std::vector<Expr> syms;
+  for (size_t i = 0; i < N; ++i) syms.push_back(ctx.symbol(numbered("$der(der(a_rather_long_name[", i) + "]))"));
+  EXPECT_EQ(ctx.symbolCount(), N);
+  for (size_t i = 0; i < N; i += 997) {
+    std::string name = numbered("$der(der(a_rather_long_name[", i) + "]))";
+    EXPECT_EQ(ctx.findSymbol(name), syms[i]);
+    EXPECT_EQ(ctx.symbol(name), syms[i]);
+    EXPECT_EQ(ctx.symbolName(syms[i]), name);
+    EXPECT_EQ(syms[i]->symbolId, i);
+  }
+  EXPECT_EQ(ctx.findSymbol("$der(der(a_rather_long_name[20000]))"), nullptr);
+  EXPECT_EQ(ctx.findSymbol(""), nullptr);
+}
+
+// S·cos(S) with S = Σ sin(s_i), so S is reached twice: 2n + 4 nodes, small (inline visited set,
+// up to 32 nodes) and large (hash set) cases.
+TEST(Storage, TraversalsAgreeOnSmallAndLargeExpressions) {
+  for (size_t n : {3u, 15u, 16u, 17u, 40u, 1000u}) {
+    Context ctx;
+    std::vector<Expr> syms, terms;
+    for (size_t i = 0; i < n; ++i) syms.push_back(ctx.symbol(numbered("s", i)));
+    for (size_t i = 0; i < n; ++i) terms.push_back(ctx.unary(Kind::Sin, syms[i]));
+    Expr sum = ctx.add(terms);
+    Expr e = ctx.mul(sum, ctx.unary(Kind::Cos, sum));
+    std::vector<Expr> fs = ctx.freeSymbols(e);
+    EXPECT_EQ(fs, syms) << n;
+    Expr root = e;
+    EXPECT_EQ(ctx.dagSize(std::span<const Expr>(&root, 1)), 2 * n + 4) << n;  // s, sin s, S, cos S, 1, *
+    EXPECT_TRUE(ctx.dependsOn(e, syms[n - 1]));
+    EXPECT_FALSE(ctx.dependsOn(e, ctx.symbol("other")));
+  }
+}
+
+TEST(Storage, MulOperandsAreOneArray) {
+  Context ctx;
+  Expr x = ctx.symbol("x"), y = ctx.symbol("y");
+  Expr m = ctx.mul(ctx.pow(x, ctx.constant(2)), ctx.unary(Kind::Sin, y));
+  ASSERT_EQ(m->kind, Kind::Mul);
+  ASSERT_EQ(m->args.size(), 2u);
+  EXPECT_EQ(m->exps.data(), m->args.data() + m->args.size());  // children: args, then exps
+  EXPECT_TRUE(m->coefs.empty());
+  Expr s = ctx.add(x, ctx.scale(3, y));
+  EXPECT_EQ(s->coefs.size(), s->args.size());
+  EXPECT_TRUE(s->exps.empty());
+}
+
+}  // namespace
