@@ -1,0 +1,82 @@
+// `qdot run` option behaviour as a user meets it (runtime/README.md, "How a run goes"): exit codes
+// (0 success, 2 bad options, 3 solver failure), the "did you mean" hint, --outputs choosing columns.
+#include "QdotRun.h"
+
+namespace qdot::simtest {
+namespace {
+
+const char* kGovernor = "examples/textbook/governor.qd";
+
+// Reference: runtime/README.md — an unknown parameter is a UsageError (exit 2) naming the closest
+// parameter ("did you mean 'omega'?"); no result rows are written.
+TEST(RunOptions, BadParameterNameExits2AndNamesTheClosest) {
+  auto r = runQdot(kGovernor, {"-p", "omgea=5", "--stop", "0.1"});
+  EXPECT_EQ(r.exitCode, 2) << r.log;
+  EXPECT_NE(r.log.find("omgea"), std::string::npos) << r.log;
+  EXPECT_NE(r.log.find("did you mean 'omega'"), std::string::npos) << r.log;
+  EXPECT_EQ(r.rows, 0u);
+
+  auto r2 = runQdot("examples/textbook/utube.qd", {"-p", "rh=900"});
+  EXPECT_EQ(r2.exitCode, 2) << r2.log;
+  EXPECT_NE(r2.log.find("did you mean 'rho'"), std::string::npos) << r2.log;
+}
+
+// Reference: runtime/README.md — stop ≤ start is a UsageError (exit 2).
+TEST(RunOptions, StopBeforeStartExits2) {
+  auto r = runQdot(kGovernor, {"--start", "2", "--stop", "1"});
+  EXPECT_EQ(r.exitCode, 2) << r.log;
+  EXPECT_NE(r.log.find("stop"), std::string::npos) << r.log;
+  EXPECT_EQ(r.rows, 0u);
+
+  auto equal = runQdot(kGovernor, {"--start", "1", "--stop", "1"});
+  EXPECT_EQ(equal.exitCode, 2) << equal.log;
+}
+
+// Reference: runtime/README.md — with --outputs a,b exactly those columns, in that order, after
+// `time`; the values are those of the full run (same solver path: the same options otherwise).
+TEST(RunOptions, OutputsSelectsColumnsInOrder) {
+  const std::vector<std::string> common = {"--stop", "0.5", "--interval", "0.05", "--invariants"};
+  auto full = runQdot(kGovernor, common);
+  ASSERT_EQ(full.exitCode, 0) << full.log;
+  EXPECT_EQ(full.header, (std::vector<std::string>{"time", "theta", "der(theta)", "jacobi"}));
+
+  auto args = common;
+  args.insert(args.end(), {"--outputs", "jacobi,theta"});
+  auto some = runQdot(kGovernor, args);
+  ASSERT_EQ(some.exitCode, 0) << some.log;
+  ASSERT_EQ(some.header, (std::vector<std::string>{"time", "jacobi", "theta"}));
+  ASSERT_EQ(some.rows, full.rows);
+  EXPECT_EQ(some.rows, 11u);
+  for (const char* name : {"time", "jacobi", "theta"}) EXPECT_EQ(some.col(name), full.col(name)) << name;
+
+  auto bad = runQdot(kGovernor, {"--stop", "0.5", "--outputs", "thet"});
+  EXPECT_EQ(bad.exitCode, 2) << bad.log;
+  EXPECT_NE(bad.log.find("did you mean 'theta'"), std::string::npos) << bad.log;
+}
+
+// Reference: the closed form x = cos t of tests/sim/models/leaves_domain.qd (ẍ + x = 0, x(0) = 1) and
+// runtime/README.md — a model that leaves its domain (s = sqrt(x) once x = cos t < 0, i.e. after
+// t = π/2) fails the run with exit 3, naming the time, and the rows computed before stay written.
+// Bounds: x at every written row by oscillationBound (A = 1, P = 2π, rtol 1e-6); s = √x by
+// 10·rtol·(|s| + 1) (algebraic: Newton's error test, atol = rtol × its start scale 1) while x ≥ 0.01.
+TEST(RunOptions, SolverFailureExits3AndKeepsTheRowsBefore) {
+  const double rtol = 1e-6;
+  auto r = runQdot("tests/sim/models/leaves_domain.qd", {});
+  EXPECT_EQ(r.exitCode, 3) << r.log;
+  EXPECT_NE(r.log.find("t = 1.5707"), std::string::npos) << "the failure time π/2:\n" << r.log;
+  ASSERT_GT(r.rows, 100u);
+  const auto& t = r.time();
+  EXPECT_LE(t.back(), M_PI / 2);
+  EXPECT_GE(t.back(), M_PI / 2 - 0.01) << "every output time before π/2 is written";
+  compareColumn(
+      r, "x", [](double tt) { return std::cos(tt); }, [&](double tt) { return oscillationBound(rtol, 1, 2 * M_PI, tt); });
+  const auto &x = r.col("x"), &s = r.col("s");
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (x[i] >= 0.01) {
+      EXPECT_NEAR(s[i], std::sqrt(x[i]), 10 * rtol * (std::fabs(s[i]) + 1)) << "t = " << t[i];
+    }
+  }
+}
+
+}  // namespace
+}  // namespace qdot::simtest
