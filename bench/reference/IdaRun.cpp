@@ -118,8 +118,6 @@ class Integrator {
   SUNLinearSolver solver_ = nullptr;
   rt::ToleranceVector tolerances_;
   bool calcIC_ = false;
-
-  friend RunResult simulateReference(const ReferenceModel&, const RunSettings&);
 };
 
 Integrator::Integrator(const ReferenceModel& model, const RunSettings& settings)
@@ -243,7 +241,7 @@ RunResult simulateReference(const ReferenceModel& model, const RunSettings& sett
 
   Clock::time_point clock = Clock::now();
   Integrator ida(model, settings);
-  ida.makeConsistent(grid.size() > 1 ? grid[1] : settings.stop);
+  ida.makeConsistent(grid[1]);  // the grid always has the start and the stop
   ida.setStopTime(settings.stop);
   result.setupSeconds = secondsSince(clock);
 

@@ -92,7 +92,6 @@ struct IdaSession::Impl {
 
   // What the last failure was, for the checking helper's message.
   bool modelFailed = false;
-  double modelFailureTime = 0;
   std::string modelError;
   std::string solverMessage;
   std::vector<std::string> warnings;
@@ -155,13 +154,12 @@ void IdaSession::Impl::check(int flag, std::string_view call, FlagFamily family)
   c.time = t;
   if (ida) {  // plain getters: they fail only on a null ida, which is excluded here
     IDAGetCurrentTime(ida, &c.time);
-    IDAGetCurrentStep(ida, &c.step);
+    IDAGetLastStep(ida, &c.step);  // the last successful step (the attempted one may have shrunk to nothing)
   }
   c.modelFailed = modelFailed;
   c.modelError = modelError;
   c.solverMessage = solverMessage;
   c.linearSolverNote = singularNote();
-  if (modelFailed) c.time = modelFailureTime;
   throw IdaError(describeFailure(flag, family, c), c.time);
 }
 
@@ -199,10 +197,13 @@ void IdaSession::Impl::clearFailure() {
 
 // --- model callbacks ------------------------------------------------------------------------
 
+// Keeps the first failure since the last reset: IDA's retries after it evaluate the model at states
+// that the failure already poisoned (NaN inputs), and reporting those would hide the cause.
 int IdaSession::Impl::onModelFailure(double time, std::string message) {
-  modelFailed = true;
-  modelFailureTime = time;
-  modelError = std::move(message);
+  if (!modelFailed) {  // time: IDA reports where it stopped (t_n), not this trial point
+    modelFailed = true;
+    modelError = std::move(message);
+  }
   return 1;  // recoverable: IDA retries with a smaller step and gives up after repeated failures
 }
 

@@ -1,0 +1,108 @@
+// vm_solve: `qdot run --backend bytecode` in one process, for timing the solve. It makes the calls
+// qdot's command line makes (compiler/driver/main.cpp runSimulate, runtime/sim/Run.cpp runModel):
+// compile to the DAE, kernels, bytecode, VM model, then rt::resolveRunOptions, rt::CsvWriter and
+// rt::simulate — but repeats the simulation and reports the solve's wall time at full precision
+// (`qdot run --stats` rounds it to milliseconds) together with IDA's counters.
+//   vm_solve MODEL.qd [--repeat R] [--json FILE] [the options of qdot run: --stop, -o, ...]
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <iostream>
+
+#include "bytecode/Emitter.h"
+#include "driver/Pipeline.h"
+#include "kernel/Kernel.h"
+#include "output/CsvWriter.h"
+#include "sim/RunOptions.h"
+#include "sim/StatsReport.h"
+#include "vm/Vm.h"
+
+namespace {
+
+using namespace qdot;
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+/// The VM model of a file and the compile time in seconds (front end, kernels, bytecode).
+struct Compiled {
+  QdotModel* model = nullptr;
+  rt::ExperimentDefaults experiment;
+  double compileSeconds = 0;
+};
+
+Compiled compile(const std::string& file) {
+  driver::Compilation c;
+  if (!driver::compileFile(c, file, "", driver::Stage::Dae)) {
+    c.diags.render(std::cerr, c.sources);
+    throw std::runtime_error("the model has errors");
+  }
+  Compiled out;
+  auto t0 = Clock::now();
+  kernel::KernelModule kernels = kernel::buildKernels(*c.dae, c.ctx);
+  if (!kernels.errors.empty()) throw std::runtime_error(kernels.errors.front());
+  bc::Module module = bytecode::emitBytecode(kernels, c.sources);
+  std::string error;
+  out.model = vm::createModel(module, error);
+  if (!out.model) throw std::runtime_error(error);
+  const auto& t = c.times;
+  out.compileSeconds = t.parse + t.check + t.flatten + t.derive + t.dae + secondsSince(t0);
+  const auto& e = c.dae->experiment;
+  out.experiment = {e.startTime, e.stopTime, e.interval, e.tolerance};
+  return out;
+}
+
+rt::SimulationResult simulateOnce(const QdotModel& model, const rt::ResolvedRun& run) {
+  std::unique_ptr<rt::CsvWriter> writer =
+      run.outputPath.empty() ? std::make_unique<rt::CsvWriter>(std::cout) : rt::CsvWriter::openFile(run.outputPath);
+  rt::SimulationResult result = rt::simulate(model, run.settings, *writer);
+  if (!result.success) throw std::runtime_error(result.message);
+  return result;
+}
+
+void writeJson(const std::string& path, const Compiled& c, const rt::SimulationResult& r,
+               const std::vector<double>& solves) {
+  const rt::SolverStats& s = r.stats;
+  std::ofstream out(path);
+  out.precision(17);
+  out << "{\"solve\": " << *std::min_element(solves.begin(), solves.end()) << ", \"solves\": [";
+  for (std::size_t i = 0; i < solves.size(); ++i) out << (i ? ", " : "") << solves[i];
+  out << "], \"setup\": " << r.setupSeconds << ", \"compile\": " << c.compileSeconds << ", \"steps\": " << s.steps
+      << ", \"residuals\": " << s.residualEvaluations << ", \"jacobians\": " << s.jacobianEvaluations
+      << ", \"iterations\": " << s.nonlinearIterations << ", \"errorTestFailures\": " << s.errorTestFailures
+      << ", \"convergenceFailures\": " << s.convergenceFailures << ", \"rows\": " << r.rows
+      << ", \"calcIC\": " << (r.computedInitialValues ? "true" : "false") << ", \"atolMin\": " << r.tolerances.atolMin
+      << ", \"atolMedian\": " << r.tolerances.atolMedian << ", \"atolMax\": " << r.tolerances.atolMax << "}\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"qdot run --backend bytecode in-process, timing the solve at full precision (bench/)"};
+  std::string file, json;
+  int repeat = 1;
+  rt::RunOptions options;
+  app.add_option("file", file, "the model file (.qd)")->required()->check(CLI::ExistingFile);
+  app.add_option("--repeat", repeat, "simulate this many times, report the fastest solve")->check(CLI::PositiveNumber);
+  app.add_option("--json", json, "write the counters and times as JSON to this file");
+  rt::addRunOptions(app, options);
+  CLI11_PARSE(app, argc, argv);
+  try {
+    Compiled c = compile(file);
+    rt::ResolvedRun run = rt::resolveRunOptions(options, c.experiment, *c.model);
+    rt::SimulationResult result;
+    std::vector<double> solves;
+    for (int r = 0; r < repeat; ++r) {
+      result = simulateOnce(*c.model, run);
+      solves.push_back(result.solveSeconds);
+    }
+    if (run.stats) std::cerr << rt::formatStats(result);
+    if (!json.empty()) writeJson(json, c, result, solves);
+    c.model->destroy(c.model);
+  } catch (const std::exception& e) {
+    std::cerr << "vm_solve: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
