@@ -2,20 +2,22 @@
 // pendulum (dense) and the spring–damper chain (KLU), residual and Jacobian coded by hand
 // (bench/reference/), integrated by SUNDIALS IDA exactly as `qdot run` integrates the .qd models.
 //   reference_sim nlink|chain --n N [--stop S] [--interval I] [--rtol R] [--atol A] [-o FILE]
-//                 [--outputs a,b] [--stats] [--repeat R] [--json FILE]
-// --repeat runs the whole simulation R times and reports the fastest solve; --json writes the
-// counters and times for bench/sim_bench.py.
+//                 [--outputs a,b] [--stats] [--repeat R] [--breakdown] [--json FILE]
+// --repeat runs the whole simulation R times and reports the fastest solve; --breakdown adds one
+// more run with the residual and Jacobian timed; --json writes the counters and times for
+// bench/sim_bench.py.
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 
 #include "reference/IdaRun.h"
 #include "reference/NLinkPendulum.h"
 #include "reference/SpringChain.h"
+#include "reference/TimedModel.h"
 
 namespace {
 
@@ -30,6 +32,7 @@ struct Options {
   std::vector<std::string> columns;
   bool stats = false;
   int repeat = 1;
+  bool breakdown = false;
   std::string json;
 };
 
@@ -50,13 +53,14 @@ RunSettings settingsFor(const Options& o, const ReferenceModel& model) {
   std::vector<std::string> names = model.variableNames();
   for (const std::string& name : o.columns) {
     auto it = std::find(names.begin(), names.end(), name);
-    if (it == names.end()) throw CLI::ValidationError("--outputs", "no variable named " + name);
+    if (it == names.end()) throw std::runtime_error("--outputs: no variable named " + name);
     s.columns.push_back(static_cast<uint32_t>(it - names.begin()));
   }
   return s;
 }
 
-void writeJson(const std::string& path, const RunResult& r, const std::vector<double>& solves) {
+void writeJson(const std::string& path, const RunResult& r, const std::vector<double>& solves,
+               const TimedModel* timed, double breakdownSolve) {
   std::ofstream out(path);
   out.precision(17);
   out << "{\"solve\": " << *std::min_element(solves.begin(), solves.end()) << ", \"solves\": [";
@@ -66,7 +70,13 @@ void writeJson(const std::string& path, const RunResult& r, const std::vector<do
       << ", \"iterations\": " << r.nonlinearIterations << ", \"errorTestFailures\": " << r.errorTestFailures
       << ", \"convergenceFailures\": " << r.convergenceFailures << ", \"rows\": " << r.rows
       << ", \"calcIC\": " << (r.computedInitialValues ? "true" : "false") << ", \"atolMin\": " << r.tolerances.atolMin
-      << ", \"atolMedian\": " << r.tolerances.atolMedian << ", \"atolMax\": " << r.tolerances.atolMax << "}\n";
+      << ", \"atolMedian\": " << r.tolerances.atolMedian << ", \"atolMax\": " << r.tolerances.atolMax;
+  if (timed) {
+    out << ", \"breakdown\": {\"solve\": " << breakdownSolve << ", \"residualSeconds\": " << timed->residualSeconds
+        << ", \"residualCalls\": " << timed->residualCalls << ", \"jacobianSeconds\": " << timed->jacobianSeconds
+        << ", \"jacobianCalls\": " << timed->jacobianCalls << "}";
+  }
+  out << "}\n";
 }
 
 }  // namespace
@@ -84,6 +94,7 @@ int main(int argc, char** argv) {
   app.add_option("--outputs", o.columns, "columns after time (default: all variables)")->delimiter(',');
   app.add_flag("--stats", o.stats, "print the counters and wall times to standard error");
   app.add_option("--repeat", o.repeat, "simulate this many times, report the fastest solve")->check(CLI::PositiveNumber);
+  app.add_flag("--breakdown", o.breakdown, "one more run timing the residual and Jacobian");
   app.add_option("--json", o.json, "write the counters and times as JSON to this file");
   CLI11_PARSE(app, argc, argv);
   try {
@@ -95,8 +106,10 @@ int main(int argc, char** argv) {
       result = simulateReference(*model, settings);
       solves.push_back(result.solveSeconds);
     }
+    TimedModel timed(*model);
+    double breakdownSolve = o.breakdown ? simulateReference(timed, settings).solveSeconds : 0;
     if (o.stats) std::cerr << formatStats(result);
-    if (!o.json.empty()) writeJson(o.json, result, solves);
+    if (!o.json.empty()) writeJson(o.json, result, solves, o.breakdown ? &timed : nullptr, breakdownSolve);
   } catch (const std::exception& e) {
     std::cerr << "reference_sim: " << e.what() << "\n";
     return 1;

@@ -2,13 +2,15 @@
 // qdot's command line makes (compiler/driver/main.cpp runSimulate, runtime/sim/Run.cpp runModel):
 // compile to the DAE, kernels, bytecode, VM model, then rt::resolveRunOptions, rt::CsvWriter and
 // rt::simulate — but repeats the simulation and reports the solve's wall time at full precision
-// (`qdot run --stats` rounds it to milliseconds) together with IDA's counters.
-//   vm_solve MODEL.qd [--repeat R] [--json FILE] [the options of qdot run: --stop, -o, ...]
+// (`qdot run --stats` rounds it to milliseconds) together with IDA's counters. --breakdown adds
+// one more run with the model's residual and Jacobian timed (their function pointers wrapped).
+//   vm_solve MODEL.qd [--repeat R] [--breakdown] [--json FILE] [the options of qdot run: --stop, -o, ...]
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <iostream>
+#include <memory>
 
 #include "bytecode/Emitter.h"
 #include "driver/Pipeline.h"
@@ -27,7 +29,7 @@ double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>
 
 /// The VM model of a file and the compile time in seconds (front end, kernels, bytecode).
 struct Compiled {
-  QdotModel* model = nullptr;
+  std::unique_ptr<QdotModel, void (*)(QdotModel*)> model{nullptr, nullptr};
   rt::ExperimentDefaults experiment;
   double compileSeconds = 0;
 };
@@ -44,13 +46,48 @@ Compiled compile(const std::string& file) {
   if (!kernels.errors.empty()) throw std::runtime_error(kernels.errors.front());
   bc::Module module = bytecode::emitBytecode(kernels, c.sources);
   std::string error;
-  out.model = vm::createModel(module, error);
-  if (!out.model) throw std::runtime_error(error);
+  QdotModel* model = vm::createModel(module, error);
+  if (!model) throw std::runtime_error(error);
+  out.model = {model, model->destroy};
   const auto& t = c.times;
   out.compileSeconds = t.parse + t.check + t.flatten + t.derive + t.dae + secondsSince(t0);
   const auto& e = c.dae->experiment;
   out.experiment = {e.startTime, e.stopTime, e.interval, e.tolerance};
   return out;
+}
+
+/// Wall time inside the model's residual and Jacobian. The ABI's functions carry no user data of
+/// their own, so the originals and the sums live here.
+struct CallbackClock {
+  decltype(QdotModel::residual) residual = nullptr;
+  decltype(QdotModel::jacobian) jacobian = nullptr;
+  double residualSeconds = 0, jacobianSeconds = 0;
+  long residualCalls = 0, jacobianCalls = 0;
+} callbackClock;
+
+int timedResidual(const QdotModel* self, double t, const double* y, const double* yp, const double* p, double* F) {
+  auto t0 = Clock::now();
+  int rc = callbackClock.residual(self, t, y, yp, p, F);
+  callbackClock.residualSeconds += secondsSince(t0);
+  ++callbackClock.residualCalls;
+  return rc;
+}
+
+int timedJacobian(const QdotModel* self, double t, const double* y, const double* yp, const double* p, double cj,
+                  double* values) {
+  auto t0 = Clock::now();
+  int rc = callbackClock.jacobian(self, t, y, yp, p, cj, values);
+  callbackClock.jacobianSeconds += secondsSince(t0);
+  ++callbackClock.jacobianCalls;
+  return rc;
+}
+
+/// Routes the model's residual and Jacobian through the timing wrappers.
+void timeCallbacks(QdotModel& model) {
+  callbackClock.residual = model.residual;
+  callbackClock.jacobian = model.jacobian;
+  model.residual = timedResidual;
+  model.jacobian = timedJacobian;
 }
 
 rt::SimulationResult simulateOnce(const QdotModel& model, const rt::ResolvedRun& run) {
@@ -62,7 +99,7 @@ rt::SimulationResult simulateOnce(const QdotModel& model, const rt::ResolvedRun&
 }
 
 void writeJson(const std::string& path, const Compiled& c, const rt::SimulationResult& r,
-               const std::vector<double>& solves) {
+               const std::vector<double>& solves, double breakdownSolve) {
   const rt::SolverStats& s = r.stats;
   std::ofstream out(path);
   out.precision(17);
@@ -73,7 +110,14 @@ void writeJson(const std::string& path, const Compiled& c, const rt::SimulationR
       << ", \"iterations\": " << s.nonlinearIterations << ", \"errorTestFailures\": " << s.errorTestFailures
       << ", \"convergenceFailures\": " << s.convergenceFailures << ", \"rows\": " << r.rows
       << ", \"calcIC\": " << (r.computedInitialValues ? "true" : "false") << ", \"atolMin\": " << r.tolerances.atolMin
-      << ", \"atolMedian\": " << r.tolerances.atolMedian << ", \"atolMax\": " << r.tolerances.atolMax << "}\n";
+      << ", \"atolMedian\": " << r.tolerances.atolMedian << ", \"atolMax\": " << r.tolerances.atolMax;
+  if (breakdownSolve > 0) {
+    const CallbackClock& b = callbackClock;
+    out << ", \"breakdown\": {\"solve\": " << breakdownSolve << ", \"residualSeconds\": " << b.residualSeconds
+        << ", \"residualCalls\": " << b.residualCalls << ", \"jacobianSeconds\": " << b.jacobianSeconds
+        << ", \"jacobianCalls\": " << b.jacobianCalls << "}";
+  }
+  out << "}\n";
 }
 
 }  // namespace
@@ -82,9 +126,11 @@ int main(int argc, char** argv) {
   CLI::App app{"qdot run --backend bytecode in-process, timing the solve at full precision (bench/)"};
   std::string file, json;
   int repeat = 1;
+  bool breakdown = false;
   rt::RunOptions options;
   app.add_option("file", file, "the model file (.qd)")->required()->check(CLI::ExistingFile);
   app.add_option("--repeat", repeat, "simulate this many times, report the fastest solve")->check(CLI::PositiveNumber);
+  app.add_flag("--breakdown", breakdown, "one more run timing the model's residual and Jacobian");
   app.add_option("--json", json, "write the counters and times as JSON to this file");
   rt::addRunOptions(app, options);
   CLI11_PARSE(app, argc, argv);
@@ -97,9 +143,13 @@ int main(int argc, char** argv) {
       result = simulateOnce(*c.model, run);
       solves.push_back(result.solveSeconds);
     }
+    double breakdownSolve = 0;
+    if (breakdown) {
+      timeCallbacks(*c.model);
+      breakdownSolve = simulateOnce(*c.model, run).solveSeconds;
+    }
     if (run.stats) std::cerr << rt::formatStats(result);
-    if (!json.empty()) writeJson(json, c, result, solves);
-    c.model->destroy(c.model);
+    if (!json.empty()) writeJson(json, c, result, solves, breakdownSolve);
   } catch (const std::exception& e) {
     std::cerr << "vm_solve: " << e.what() << "\n";
     return 1;

@@ -33,7 +33,7 @@ bool runStages(Compilation& c, uint32_t file, std::string_view model, Stage unti
     return false;
   }
   if (c.diags.hasErrors() || until == Stage::Check) return !c.diags.hasErrors();
-  c.flat = timed(c.times.flatten, [&] { return flat::flatten(*c.checked, c.ctx, c.diags); });
+  c.flat = timed(c.times.flatten, [&] { return flat::flatten(*c.checked, c.ctx, c.diags, c.limits); });
   if (!c.flat || until == Stage::Flatten) return c.flat.has_value() && !c.diags.hasErrors();
   c.eom = timed(c.times.derive, [&] { return mech::deriveEquationsOfMotion(*c.flat, c.ctx, c.diags); });
   if (!c.eom || until == Stage::Derive) return c.eom.has_value() && !c.diags.hasErrors();

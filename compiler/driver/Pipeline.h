@@ -9,7 +9,7 @@
 
 #include "ast/AST.h"
 #include "dae/Dae.h"
-#include "flatten/FlatModel.h"
+#include "flatten/Flatten.h"
 #include "mechanics/EulerLagrange.h"
 #include "sema/Sema.h"
 #include "support/Diagnostic.h"
@@ -35,6 +35,7 @@ struct Compilation {
   std::optional<mech::EquationsOfMotion> eom;
   std::optional<dae::Dae> dae;
   StageTimes times;
+  flat::FlattenLimits limits;  ///< size limits of flattening (tests and fuzzing lower them)
 
   Compilation() = default;
   Compilation(const Compilation&) = delete;

@@ -10,6 +10,7 @@
 #include "bytecode/Emitter.h"
 #include "driver/Pipeline.h"
 #include "kernel/Kernel.h"
+#include "llvm/JitModel.h"
 #include "sim/Run.h"
 #include "vm/Vm.h"
 
@@ -79,14 +80,19 @@ int runSimulate(const Options& o) {
     return finish(c, true);
   }
   t0 = std::chrono::steady_clock::now();
-  bc::Module module = bytecode::emitBytecode(kernels, c.sources);
-  double codegenSeconds = secondsSince(t0);
-  if (o.emit == "bytecode") {
-    vm::disassemble(std::cout, module);
-    return finish(c, true);
-  }
   std::string error;
-  QdotModel* model = vm::createModel(module, error);
+  QdotModel* model = nullptr;
+  if (o.backend == "llvm" && o.emit.empty()) {
+    model = llvmbackend::createJitModel(kernels, c.sources, 2, error);
+  } else {
+    bc::Module module = bytecode::emitBytecode(kernels, c.sources);
+    if (o.emit == "bytecode") {
+      vm::disassemble(std::cout, module);
+      return finish(c, true);
+    }
+    model = vm::createModel(module, error);
+  }
+  double codegenSeconds = secondsSince(t0);
   if (!model) {
     std::cerr << "qdot: internal error: " << error << "\n";
     return 1;
@@ -96,7 +102,7 @@ int runSimulate(const Options& o) {
     const auto& t = c.times;
     std::cerr << "compile [ms]: parse " << t.parse * 1e3 << ", check " << t.check * 1e3 << ", flatten "
               << t.flatten * 1e3 << ", derive " << t.derive * 1e3 << ", dae " << t.dae * 1e3 << ", kernel "
-              << kernelSeconds * 1e3 << ", bytecode " << codegenSeconds * 1e3 << "\n";
+              << kernelSeconds * 1e3 << ", codegen (" << o.backend << ") " << codegenSeconds * 1e3 << "\n";
   }
   int code = rt::runModel(*model, o.run, experimentOf(*c.dae), std::cout, std::cerr);
   model->destroy(model);
@@ -135,7 +141,8 @@ int main(int argc, char** argv) {
   auto* run = app.add_subcommand("run", "Simulate a model with SUNDIALS IDA and write the results as CSV");
   run->add_option("file", o.file, "the model file (.qd)")->required()->check(CLI::ExistingFile);
   run->add_option("--model", o.model, "the model (default: the last model in the file)");
-  run->add_option("--backend", o.backend, "code generator: bytecode (the VM)")->check(CLI::IsMember({"bytecode"}));
+  run->add_option("--backend", o.backend, "code generator: bytecode (the VM, default) or llvm (JIT)")
+      ->check(CLI::IsMember({"bytecode", "llvm"}));
   run->add_option("--emit", o.emit, "print a stage's output instead of running: kernel, bytecode")
       ->check(CLI::IsMember({"kernel", "bytecode"}));
   rt::addRunOptions(*run, o.run);

@@ -14,8 +14,9 @@ namespace fs = std::filesystem;
 
 std::vector<std::string> corpusFiles() {
   std::vector<std::string> files;
-  for (const auto& e : fs::directory_iterator(std::string(QDOT_SOURCE_DIR) + "/tests/diagnostics"))
-    if (e.path().extension() == ".qd") files.push_back(e.path().filename().string());
+  const fs::path root = std::string(QDOT_SOURCE_DIR) + "/tests/diagnostics";
+  for (const auto& e : fs::recursive_directory_iterator(root))
+    if (e.path().extension() == ".qd") files.push_back(fs::relative(e.path(), root).string());
   std::sort(files.begin(), files.end());
   return files;
 }

@@ -1,0 +1,44 @@
+// The ORC JIT session of one model (internal to compiler/llvm): lowers a KernelModule, optimises
+// it with the new pass manager, compiles it in-process with LLJIT and hands out the entry points.
+// No LLVM type in this header, so JitModel.cpp's ABI code stays plain C++.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <string>
+
+#include "llvm/JitModel.h"
+
+namespace qdot::llvmbackend {
+
+/// The C signature of every compiled program (see README.md):
+///   tcj = {t, cj}; y, yp [nVariables]; p, given, overridden [nParameters] (inputs a program does
+///   not read may be null); out [outputCount]; spill [spill slots of the program] (scratch).
+/// `out` and `spill` must not overlap the inputs.
+using ProgramFn = void (*)(const double* tcj, const double* y, const double* yp, const double* p, const double* given,
+                           const uint8_t* overridden, double* out, double* spill);
+
+/// Compiled code of every program; owns the LLJIT instance (and so the machine code).
+class JitSession {
+ public:
+  /// Compiles `k`; nullptr with `error` on failure. Fills `stats` if given.
+  static std::unique_ptr<JitSession> compile(const kernel::KernelModule& k, const JitOptions& options,
+                                             std::string& error, JitStats* stats);
+  ~JitSession();
+  JitSession(const JitSession&) = delete;
+  JitSession& operator=(const JitSession&) = delete;
+
+  /// Entry point of a program.
+  ProgramFn program(kernel::ProgramId id) const { return entries_[static_cast<size_t>(id)]; }
+  /// Doubles of spill memory the program needs.
+  uint32_t spillSlots(kernel::ProgramId id) const { return spill_[static_cast<size_t>(id)]; }
+
+ private:
+  struct Impl;
+  JitSession();
+  std::unique_ptr<Impl> impl_;
+  std::array<ProgramFn, kernel::kProgramCount> entries_{};
+  std::array<uint32_t, kernel::kProgramCount> spill_{};
+};
+
+}  // namespace qdot::llvmbackend

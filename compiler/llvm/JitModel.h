@@ -1,0 +1,50 @@
+// The LLVM backend's public interface: compiles a kernel::KernelModule to native code with LLVM's
+// ORC JIT (in-process) and wraps it as a QdotModel (runtime/include/qdot/model_abi.h), the same
+// ABI the bytecode VM implements. No LLVM type appears here; LLVM headers stay in compiler/llvm.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+
+#include "kernel/Kernel.h"
+#include "qdot/model_abi.h"
+#include "support/SourceManager.h"
+
+namespace qdot::llvmbackend {
+
+/// How to compile.
+struct JitOptions {
+  int optLevel = 2;  ///< code generator level 0-3 (0: fast instruction selection and register allocation)
+  /// Programs longer than this (kernel instructions) are split into several LLVM functions so
+  /// that compile time stays linear in the program size (LLVM is super-linear on huge blocks).
+  uint32_t maxInstructionsPerFunction = 500;
+  /// Level of the new-pass-manager IR pipeline (buildPerModuleDefaultPipeline), -1 = optLevel.
+  /// Default 0 (none): the kernel IR is already CSE'd straight-line code, and measured, O2's
+  /// pipeline costs compile time without making the code faster (README.md).
+  int pipelineLevel = 0;
+  /// Models with more kernel instructions than this are code-generated at level 0 whatever
+  /// optLevel says (compile time ~20x lower, code ~15% slower on the chain; README.md).
+  size_t largeModelInstructions = 200000;
+};
+
+/// What compiling cost, and how the programs were split (for tests and measurements).
+struct JitStats {
+  double lowerSeconds = 0;     ///< kernel IR -> LLVM IR
+  double optimiseSeconds = 0;  ///< the optimisation pipeline
+  double codegenSeconds = 0;   ///< machine code generation and linking (ORC lookup)
+  std::array<uint32_t, kernel::kProgramCount> functions{};   ///< LLVM functions per program
+  std::array<uint32_t, kernel::kProgramCount> spillSlots{};  ///< values passed between them
+};
+
+/// Compiles every program of `k` and returns a model implementing the whole ABI, or nullptr with
+/// `error` set. `sm` resolves source locations for lastError ("... in equation 3 at model.qd:9").
+/// The JIT session lives inside the model; destroy() releases it. Like the VM's models, one model
+/// must not be called from several threads at once (it owns scratch memory).
+QdotModel* createJitModel(const kernel::KernelModule& k, const SourceManager& sm, int optLevel, std::string& error);
+
+/// The same with every option, optionally reporting compile statistics.
+QdotModel* createJitModel(const kernel::KernelModule& k, const SourceManager& sm, const JitOptions& options,
+                          std::string& error, JitStats* stats = nullptr);
+
+}  // namespace qdot::llvmbackend

@@ -1,0 +1,110 @@
+// qdot_llvm_bench: compile-time and run-time measurements of the LLVM backend (README.md).
+//   qdot_llvm_bench FILE.qd [n] [optLevel] [maxInstructionsPerFunction] [pipelineLevel]
+// Runs the front end (overriding `Integer n = ...` with n if given), then JIT-compiles the kernels
+// and prints the compile phases, and the residual evaluation time of the JIT and the bytecode VM.
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <regex>
+#include <sstream>
+
+#include "bytecode/Emitter.h"
+#include "dae/Dae.h"
+#include "flatten/Flatten.h"
+#include "kernel/Kernel.h"
+#include "llvm/JitModel.h"
+#include "mechanics/EulerLagrange.h"
+#include "sema/Sema.h"
+#include "syntax/Parser.h"
+#include "vm/Vm.h"
+
+using namespace qdot;
+using Clock = std::chrono::steady_clock;
+
+static double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// Nanoseconds per residual call (repeats until ~0.3 s have passed).
+static double residualNs(const QdotModel* q, const std::vector<double>& p) {
+  size_t n = q->nVariables;
+  std::vector<double> y(n), yp(n), F(n);
+  for (size_t i = 0; i < n; ++i) y[i] = 0.01 * (i % 17), yp[i] = 0.02 * (i % 5);
+  size_t calls = 0;
+  auto start = Clock::now();
+  double elapsed = 0;
+  do {
+    for (int r = 0; r < 16; ++r, ++calls) q->residual(q, 0.1, y.data(), yp.data(), p.data(), F.data());
+    elapsed = since(start);
+  } while (elapsed < 0.3);
+  return elapsed / calls * 1e9;
+}
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::cerr << "usage: qdot_llvm_bench FILE.qd [n] [optLevel] [maxInstructionsPerFunction] [pipelineLevel]\n";
+    return 2;
+  }
+  std::ifstream in(argv[1]);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string text = ss.str();
+  if (argc > 2) text = std::regex_replace(text, std::regex("Integer n = [0-9]+"), std::string("Integer n = ") + argv[2]);
+  llvmbackend::JitOptions options;
+  if (argc > 3) options.optLevel = std::atoi(argv[3]);
+  if (argc > 4) options.maxInstructionsPerFunction = static_cast<uint32_t>(std::atol(argv[4]));
+  if (argc > 5) options.pipelineLevel = std::atoi(argv[5]);
+
+  auto t0 = Clock::now();
+  SourceManager sources;
+  DiagnosticEngine diags;
+  sym::Context ctx;
+  uint32_t file = sources.addBuffer(argv[1], text);
+  auto ast = syntax::parse(sources, file, diags);
+  std::optional<sema::CheckedModel> checked;
+  std::optional<flat::FlatModel> flat;
+  std::optional<mech::EquationsOfMotion> eom;
+  std::optional<dae::Dae> dae;
+  if (!diags.hasErrors()) checked = sema::checkModel(*ast, "", diags);
+  if (checked && !diags.hasErrors()) flat = flat::flatten(*checked, ctx, diags);
+  if (flat) eom = mech::deriveEquationsOfMotion(*flat, ctx, diags);
+  if (eom) dae = dae::buildDae(*flat, *eom, ctx, diags);
+  if (!dae || diags.hasErrors()) {
+    diags.render(std::cerr, sources);
+    return 1;
+  }
+  kernel::KernelModule k = kernel::buildKernels(*dae, ctx);
+  double frontEnd = since(t0);
+  size_t instructions = 0;
+  for (const auto& p : k.programs) instructions += p.code.size();
+
+  std::string error;
+  llvmbackend::JitStats stats;
+  auto t1 = Clock::now();
+  QdotModel* jit = llvmbackend::createJitModel(k, sources, options, error, &stats);
+  double total = since(t1);
+  if (!jit) {
+    std::cerr << error << "\n";
+    return 1;
+  }
+  auto t2 = Clock::now();
+  bc::Module module = bytecode::emitBytecode(k, sources);
+  QdotModel* vm = vm::createModel(module, error);
+  double vmBuild = since(t2);
+
+  std::vector<double> p(jit->nParameters);
+  jit->parameters(jit, nullptr, nullptr, p.data());
+  uint32_t functions = 0;
+  for (uint32_t f : stats.functions) functions += f;
+  std::cout << "n=" << (argc > 2 ? argv[2] : "-") << " O" << options.optLevel << " pipeline O" << (options.pipelineLevel >= 0 ? options.pipelineLevel : options.optLevel) << " split " << options.maxInstructionsPerFunction << " variables=" << jit->nVariables
+            << " instructions=" << instructions << " residual=" << k.program(kernel::ProgramId::Residual).code.size()
+            << " functions=" << functions << " frontend=" << frontEnd << "s jit=" << total
+            << "s (lower " << stats.lowerSeconds << " opt " << stats.optimiseSeconds << " codegen "
+            << stats.codegenSeconds << ") vmbuild=" << vmBuild << "s";
+  if (jit->nVariables <= 20000)
+    std::cout << " residual_ns jit=" << residualNs(jit, p) << " vm=" << residualNs(vm, p);
+  std::cout << "\n";
+  jit->destroy(jit);
+  vm->destroy(vm);
+  return 0;
+}
