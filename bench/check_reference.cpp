@@ -135,8 +135,8 @@ bool compare(const char* title, const bench::ReferenceModel& r, const QdotModel&
     worstJ = std::max(worstJ, largestDifference(Jr, qdotJacobian(q, p, cj, y, yp)));
   }
   bool ok = interface && pattern && worstF < 1e-12 && worstJ < 1e-12;
-  std::printf("| %s | %d | %u | %s | %.1e | %.1e | %s | %s |\n", title, n, N, interface ? "same" : "DIFFERENT",
-              worstF, worstJ, r.sparse() ? (pattern ? "same" : "DIFFERENT") : "dense", ok ? "yes" : "**NO**");
+  std::printf("| %s | %d | %u | %s | %.1e | %.1e | %s | %s |\n", title, n, N, interface ? "same" : "DIFFERENT", worstF,
+              worstJ, r.sparse() ? (pattern ? "same" : "DIFFERENT") : "dense", ok ? "yes" : "**NO**");
   return ok;
 }
 
@@ -148,7 +148,9 @@ int main() {
   constexpr int kStates = 20;
   bool ok = true;
   try {
-    std::printf("| model | n | unknowns | names, flags, start values | max rel. diff F | max rel. diff J | CSC pattern | agrees |\n");
+    std::printf(
+        "| model | n | unknowns | names, flags, start values | max rel. diff F | max rel. diff J | CSC pattern | "
+        "agrees |\n");
     std::printf("|---|---:|---:|---|---:|---:|---|---|\n");
     for (int n : {2, 3, 8}) {
       ModelPtr q = compileWithSize(dir + "examples/pendulum/nlink.qd", n);

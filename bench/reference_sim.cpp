@@ -59,8 +59,8 @@ RunSettings settingsFor(const Options& o, const ReferenceModel& model) {
   return s;
 }
 
-void writeJson(const std::string& path, const RunResult& r, const std::vector<double>& solves,
-               const TimedModel* timed, double breakdownSolve) {
+void writeJson(const std::string& path, const RunResult& r, const std::vector<double>& solves, const TimedModel* timed,
+               double breakdownSolve) {
   std::ofstream out(path);
   out.precision(17);
   out << "{\"solve\": " << *std::min_element(solves.begin(), solves.end()) << ", \"solves\": [";
@@ -93,7 +93,8 @@ int main(int argc, char** argv) {
   app.add_option("-o", o.output, "CSV file (default: standard output)");
   app.add_option("--outputs", o.columns, "columns after time (default: all variables)")->delimiter(',');
   app.add_flag("--stats", o.stats, "print the counters and wall times to standard error");
-  app.add_option("--repeat", o.repeat, "simulate this many times, report the fastest solve")->check(CLI::PositiveNumber);
+  app.add_option("--repeat", o.repeat, "simulate this many times, report the fastest solve")
+      ->check(CLI::PositiveNumber);
   app.add_flag("--breakdown", o.breakdown, "one more run timing the residual and Jacobian");
   app.add_option("--json", o.json, "write the counters and times as JSON to this file");
   CLI11_PARSE(app, argc, argv);

@@ -153,8 +153,8 @@ Integrator::~Integrator() {
 void Integrator::applyTolerances() {
   std::vector<double> nominal(n_, 0.0);  // the models give no nominal values
   std::vector<int32_t> differential(n_, 1);
-  tolerances_ = rt::buildTolerances(settings_.rtol, settings_.atol, {data(y_), static_cast<std::size_t>(n_)},
-                                    nominal, differential);
+  tolerances_ = rt::buildTolerances(settings_.rtol, settings_.atol, {data(y_), static_cast<std::size_t>(n_)}, nominal,
+                                    differential);
   std::copy(tolerances_.atol.begin(), tolerances_.atol.end(), data(atol_));
   check(IDASVtolerances(ida_, settings_.rtol, atol_), "IDASVtolerances");
 }
@@ -273,8 +273,8 @@ std::string formatStats(const RunResult& r) {
                 "  tolerances             rtol %g, atol min %.3g, median %.3g, max %.3g\n"
                 "  rows written           %zu\n"
                 "  wall time              setup %.6f s, solve %.6f s\n",
-                r.steps, r.lastStep, r.lastOrder, r.residualEvaluations, r.jacobianEvaluations,
-                r.nonlinearIterations, r.errorTestFailures, r.convergenceFailures, r.sparse ? "klu" : "dense",
+                r.steps, r.lastStep, r.lastOrder, r.residualEvaluations, r.jacobianEvaluations, r.nonlinearIterations,
+                r.errorTestFailures, r.convergenceFailures, r.sparse ? "klu" : "dense",
                 r.computedInitialValues ? "made consistent by IDACalcIC" : "consistent as given", t.rtol, t.atolMin,
                 t.atolMedian, t.atolMax, r.rows, r.setupSeconds, r.solveSeconds);
   return text;

@@ -30,8 +30,8 @@ class ReferenceModel {
   /// Dense models: J = dF/dy + cj dF/dy' into a zeroed column-major size() x size() array.
   virtual void denseJacobian(double cj, const double* y, const double* yp, double* J) const {}
   /// Sparse models: the CSC pattern (columnStarts[size()+1], rowIndices[nnz]) and its values.
-  virtual void sparseJacobian(double cj, const double* y, const double* yp, int64_t* columnStarts,
-                              int64_t* rowIndices, double* values) const {}
+  virtual void sparseJacobian(double cj, const double* y, const double* yp, int64_t* columnStarts, int64_t* rowIndices,
+                              double* values) const {}
 };
 
 }  // namespace qdot::bench

@@ -38,8 +38,8 @@ void SpringChain::residual(const double* y, const double* yp, double* F) const {
 
 // Column of x_j: rows j−1, j, j+1 (−k, 2k or k at the free end, −k) and n+j (cj).
 // Column of v_j: rows j−1, j, j+1 (−c, 2c + m cj or c + m cj, −c) and n+j (−1).
-void SpringChain::sparseJacobian(double cj, const double*, const double*, int64_t* columnStarts,
-                                 int64_t* rowIndices, double* values) const {
+void SpringChain::sparseJacobian(double cj, const double*, const double*, int64_t* columnStarts, int64_t* rowIndices,
+                                 double* values) const {
   const int n = n_;
   int64_t at = 0;
   auto put = [&](int64_t row, double value) {
