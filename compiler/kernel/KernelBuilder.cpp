@@ -2,6 +2,7 @@
 // through one CSE together (shared temporaries) and are then lowered as two programs, each
 // computing only the temporaries it needs: IDA evaluates the residual far more often than the
 // Jacobian, so the residual must not pay for Jacobian-only work.
+#include <unordered_map>
 #include <algorithm>
 #include <limits>
 #include <unordered_set>
@@ -36,6 +37,7 @@ class Builder {
 
  private:
   const dae::Dae& dae_;
+  std::unordered_map<int, std::string> nameOfFlat_;
   sym::Context& ctx_;
   KernelModule m_;
   std::vector<uint32_t> equationSource_;
@@ -68,13 +70,16 @@ class Builder {
     return v.role == dae::VarRole::Coordinate || v.role == dae::VarRole::Velocity || v.start != nullptr;
   }
 
-  std::string variableNameOfFlat(int flatVar) const {
-    for (const auto& v : dae_.variables)
-      if (v.flatVar == flatVar) return v.name;
-    return "?";
+  // Name of the DAE variable that is flat variable `flatVar` (a map, built once: labels are made
+  // for every equation, and a search per label would be quadratic in the model size).
+  std::string variableNameOfFlat(int flatVar) {
+    if (nameOfFlat_.empty())
+      for (const auto& v : dae_.variables) nameOfFlat_.emplace(v.flatVar, v.name);
+    auto it = nameOfFlat_.find(flatVar);
+    return it == nameOfFlat_.end() ? "?" : it->second;
   }
 
-  std::string equationLabel(size_t i, const dae::Equation& e) const {
+  std::string equationLabel(size_t i, const dae::Equation& e) {
     std::string label = "equation " + std::to_string(i + 1);
     switch (e.origin.kind) {
       case flat::OriginKind::EulerLagrange:
