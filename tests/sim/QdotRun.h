@@ -113,6 +113,10 @@ inline RunResult runQdot(const std::string& model, const std::vector<std::string
   TempFile csv(".csv"), err(".log");
   std::vector<std::string> argv = {QDOT_BINARY, "run", modelPath(model)};
   argv.insert(argv.end(), args.begin(), args.end());
+  if (const char* backend = std::getenv("QDOT_TEST_BACKEND")) {  // CTest runs the suite on each backend
+    argv.push_back("--backend");
+    argv.push_back(backend);
+  }
   argv.push_back("-o");
   argv.push_back(csv.path());
   std::vector<char*> cargv;
