@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "llvm/Diagnose.h"
+#include "qdot/model_table.hpp"
 #include "llvm/Jit.h"
 
 namespace qdot::llvmbackend {
@@ -20,8 +21,7 @@ struct JitModel : QdotModel {
   std::vector<std::string> where;  // location text per kernel source
   std::unique_ptr<JitSession> session;
   mutable std::array<std::vector<double>, kernel::kProgramCount> spill;
-  std::vector<const char*> variableNamePtrs, parameterNamePtrs, parameterDescriptionPtrs, outputNamePtrs,
-      invariantNamePtrs;
+  ModelNameTable names;  // what the table's name arrays point into
   std::vector<double> noneGiven;  // used when the runtime passes no given values
   std::vector<uint8_t> noneOverridden;
   mutable std::vector<double> startScratch;  // [y0 | yp0 | nominal]
@@ -30,11 +30,6 @@ struct JitModel : QdotModel {
 
 const JitModel& self(const QdotModel* m) { return *static_cast<const JitModel*>(m); }
 
-std::vector<const char*> pointers(const std::vector<std::string>& names) {
-  std::vector<const char*> out;
-  for (const auto& n : names) out.push_back(n.c_str());
-  return out;
-}
 
 // The inputs of one call, as the compiled code and the kernel diagnosis both need them.
 struct Call {
@@ -123,22 +118,7 @@ const char* lastError(const QdotModel* s) { return self(s).error.c_str(); }
 void destroy(QdotModel* s) { delete static_cast<JitModel*>(s); }
 
 void fillTable(JitModel& m) {
-  const kernel::KernelModule& k = m.kernels;
-  m.abiVersion = QDOT_MODEL_ABI_VERSION;
-  m.name = k.name.c_str();
-  m.nVariables = static_cast<uint32_t>(k.variableNames.size());
-  m.nParameters = static_cast<uint32_t>(k.parameterNames.size());
-  m.nOutputs = static_cast<uint32_t>(k.outputNames.size());
-  m.nInvariants = static_cast<uint32_t>(k.invariantNames.size());
-  m.variableNames = m.variableNamePtrs.data();
-  m.isDifferential = k.isDifferential.data();
-  m.parameterNames = m.parameterNamePtrs.data();
-  m.parameterDescriptions = m.parameterDescriptionPtrs.data();
-  m.outputNames = m.outputNamePtrs.data();
-  m.invariantNames = m.invariantNamePtrs.data();
-  m.jacobianNonzeros = static_cast<uint32_t>(k.jacobianRowIndices.size());
-  m.jacobianColumnStarts = k.jacobianColumnStarts.data();
-  m.jacobianRowIndices = k.jacobianRowIndices.data();
+  fillModelTable(m, m.names, m.kernels);
   m.parameters = parameters, m.initialValues = initialValues, m.fixedStarts = fixedStarts;
   m.residual = residual, m.jacobian = jacobian, m.outputs = outputs, m.invariants = invariants;
   m.lastError = lastError, m.destroy = destroy;
@@ -175,11 +155,6 @@ QdotModel* createJitModel(const kernel::KernelModule& k, const SourceManager& sm
   m->session = std::move(session);
   for (size_t i = 0; i < kernel::kProgramCount; ++i)
     m->spill[i].assign(m->session->spillSlots(static_cast<ProgramId>(i)), 0.0);
-  m->variableNamePtrs = pointers(m->kernels.variableNames);
-  m->parameterNamePtrs = pointers(m->kernels.parameterNames);
-  m->parameterDescriptionPtrs = pointers(m->kernels.parameterDescriptions);
-  m->outputNamePtrs = pointers(m->kernels.outputNames);
-  m->invariantNamePtrs = pointers(m->kernels.invariantNames);
   m->noneGiven.assign(m->kernels.parameterNames.size(), 0.0);
   m->noneOverridden.assign(m->kernels.parameterNames.size(), 0);
   m->startScratch.assign(3 * m->kernels.variableCount(), 0.0);

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "qdot/model_table.hpp"
 #include "vm/Interpreter.h"
 #include "vm/Vm.h"
 
@@ -13,8 +14,7 @@ namespace {
 struct VmModel : QdotModel {
   bc::Module module;
   mutable std::array<std::vector<double>, bc::kFunctionCount> registers;
-  std::vector<const char*> variableNamePtrs, parameterNamePtrs, parameterDescriptionPtrs, outputNamePtrs,
-      invariantNamePtrs;
+  ModelNameTable names;  // what the table's name arrays point into
   std::vector<double> noneGiven;     // used when the runtime passes no given values
   std::vector<uint8_t> noneOverridden;
   mutable std::vector<double> startScratch;  // [y0 | yp0 | nominal]
@@ -23,11 +23,6 @@ struct VmModel : QdotModel {
 
 const VmModel& self(const QdotModel* m) { return *static_cast<const VmModel*>(m); }
 
-std::vector<const char*> pointers(const std::vector<std::string>& names) {
-  std::vector<const char*> out;
-  for (const auto& n : names) out.push_back(n.c_str());
-  return out;
-}
 
 int run(const VmModel& m, bc::FunctionId id, const Inputs& in, double* out) {
   const bc::Function& f = m.module.function(id);
@@ -97,22 +92,7 @@ const char* lastError(const QdotModel* s) { return self(s).error.c_str(); }
 void destroy(QdotModel* s) { delete static_cast<VmModel*>(s); }
 
 void fillTable(VmModel& m) {
-  const bc::Module& b = m.module;
-  m.abiVersion = QDOT_MODEL_ABI_VERSION;
-  m.name = b.name.c_str();
-  m.nVariables = static_cast<uint32_t>(b.variableNames.size());
-  m.nParameters = static_cast<uint32_t>(b.parameterNames.size());
-  m.nOutputs = static_cast<uint32_t>(b.outputNames.size());
-  m.nInvariants = static_cast<uint32_t>(b.invariantNames.size());
-  m.variableNames = m.variableNamePtrs.data();
-  m.isDifferential = b.isDifferential.data();
-  m.parameterNames = m.parameterNamePtrs.data();
-  m.parameterDescriptions = m.parameterDescriptionPtrs.data();
-  m.outputNames = m.outputNamePtrs.data();
-  m.invariantNames = m.invariantNamePtrs.data();
-  m.jacobianNonzeros = static_cast<uint32_t>(b.jacobianRowIndices.size());
-  m.jacobianColumnStarts = b.jacobianColumnStarts.data();
-  m.jacobianRowIndices = b.jacobianRowIndices.data();
+  fillModelTable(m, m.names, m.module);
   m.parameters = parameters, m.initialValues = initialValues, m.fixedStarts = fixedStarts;
   m.residual = residual, m.jacobian = jacobian, m.outputs = outputs, m.invariants = invariants;
   m.lastError = lastError, m.destroy = destroy;
@@ -125,11 +105,6 @@ QdotModel* createModel(const bc::Module& module, std::string& error) {
   auto* m = new VmModel();
   m->module = module;
   for (uint32_t f = 0; f < bc::kFunctionCount; ++f) m->registers[f] = makeRegisters(m->module.functions[f]);
-  m->variableNamePtrs = pointers(m->module.variableNames);
-  m->parameterNamePtrs = pointers(m->module.parameterNames);
-  m->parameterDescriptionPtrs = pointers(m->module.parameterDescriptions);
-  m->outputNamePtrs = pointers(m->module.outputNames);
-  m->invariantNamePtrs = pointers(m->module.invariantNames);
   m->noneGiven.assign(m->module.parameterNames.size(), 0.0);
   m->noneOverridden.assign(m->module.parameterNames.size(), 0);
   m->startScratch.assign(3 * m->module.variableNames.size(), 0.0);
