@@ -5,7 +5,8 @@ once natively (--breakdown: how many residual and Jacobian calls) and once under
 collection switched on only inside the simulation (rt::simulate, bench::simulateReference: IDA
 setup, the consistent start, IDASolve over the grid, writing the rows; not the compiler). The
 horizons are those on which both take identical steps, so the differences are evaluation costs.
-Usage: profile_solve.py --build DIR [--quick]   (from the repository root; a few minutes)"""
+With --backend llvm the qdot side is `vm_solve --backend llvm` (the JIT); the VM rows are then empty.
+Usage: profile_solve.py --build DIR [--quick] [--backend bytecode|llvm]   (from the repository root; a few minutes)"""
 import argparse
 import json
 import os
@@ -45,6 +46,9 @@ def options(case):
     return result
 
 
+BACKEND = "bytecode"
+
+
 def commands(build, case, directory):
     title, kind, source, n, *_ = case
     with open(source) as f:
@@ -53,7 +57,7 @@ def commands(build, case, directory):
     with open(model, "w") as f:
         f.write(text)
     hand = [f"{build}/bench/reference_sim", kind, "--n", str(n)] + options(case)
-    qdot = [f"{build}/bench/vm_solve", model] + options(case)
+    qdot = [f"{build}/bench/vm_solve", model, "--backend", BACKEND] + options(case)
     return hand, qdot
 
 
@@ -94,12 +98,15 @@ def print_case(case, hand, qdot, hand_calls, qdot_calls):
     whole_hand = total(hand, r"bench::simulateReference\(")
     whole_qdot = total(qdot, r"qdot::rt::simulate\(")
     print(f"\n#### {title}, n = {n}, stop {stop:g} s ({qdot_calls['steps']} steps either way)\n")
-    print("| million instructions | hand-written | qdot VM | qdot − hand | qdot / hand |")
+    name = "qdot VM" if BACKEND == "bytecode" else "qdot JIT"
+    print(f"| million instructions | hand-written | {name} | qdot − hand | qdot / hand |")
     print("|---|---:|---:|---:|---:|")
     print(f"| **whole simulation** | {mega(whole_hand)} | {mega(whole_qdot)} | {mega(whole_qdot - whole_hand)} "
           f"| **{whole_qdot / whole_hand:.2f}** |")
     rest_hand, rest_qdot = whole_hand, whole_qdot
     for label, hand_pattern, qdot_pattern in CATEGORIES:
+        if BACKEND != "bytecode" and "VM interpreting" in label:
+            continue
         h, q = total(hand, hand_pattern), total(qdot, qdot_pattern)
         if not label.startswith(" "):
             rest_hand -= h
@@ -119,10 +126,15 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--build", default="build")
     parser.add_argument("--quick", action="store_true", help="the N-link pendulum only")
+    parser.add_argument("--backend", default="bytecode", choices=["bytecode", "llvm"])
+    parser.add_argument("--max-n", type=int, default=None, help="only cases with n up to this")
     args = parser.parse_args()
-    print("\n### Profile: instructions inside the simulation (callgrind)")
+    global BACKEND
+    BACKEND = args.backend
+    which = "VM" if BACKEND == "bytecode" else "LLVM JIT"
+    print(f"\n### Profile: instructions inside the simulation (callgrind), qdot {which}")
     with tempfile.TemporaryDirectory(prefix="qdot-profile-") as directory:
-        for case in CASES[:1] if args.quick else CASES:
+        for case in CASES[:1] if args.quick else [c for c in CASES if args.max_n is None or c[3] <= args.max_n]:
             hand_cmd, qdot_cmd = commands(args.build, case, directory)
             hand_calls, qdot_calls = native(hand_cmd, directory), native(qdot_cmd, directory)
             if (hand_calls["steps"], hand_calls["residuals"]) != (qdot_calls["steps"], qdot_calls["residuals"]):

@@ -1,10 +1,12 @@
-// vm_solve: `qdot run --backend bytecode` in one process, for timing the solve. It makes the calls
+// vm_solve: `qdot run --backend bytecode|llvm` in one process, for timing the solve. It makes the calls
 // qdot's command line makes (compiler/driver/main.cpp runSimulate, runtime/sim/Run.cpp runModel):
-// compile to the DAE, kernels, bytecode, VM model, then rt::resolveRunOptions, rt::CsvWriter and
+// compile to the DAE, kernels, bytecode and VM model (--backend bytecode, the default) or the LLVM
+// JIT model (--backend llvm: llvmbackend::createJitModel(kernels, sources, 2, error), exactly as
+// qdot run), then rt::resolveRunOptions, rt::CsvWriter and
 // rt::simulate — but repeats the simulation and reports the solve's wall time at full precision
 // (`qdot run --stats` rounds it to milliseconds) together with IDA's counters. --breakdown adds
 // one more run with the model's residual and Jacobian timed (their function pointers wrapped).
-//   vm_solve MODEL.qd [--repeat R] [--breakdown] [--json FILE] [the options of qdot run: --stop, -o, ...]
+//   vm_solve MODEL.qd [--backend bytecode|llvm] [--repeat R] [--breakdown] [--json FILE] [the options of qdot run: --stop, -o, ...]
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -15,6 +17,9 @@
 #include "bytecode/Emitter.h"
 #include "driver/Pipeline.h"
 #include "kernel/Kernel.h"
+#ifdef QDOT_BENCH_LLVM
+#include "llvm/JitModel.h"
+#endif
 #include "output/CsvWriter.h"
 #include "sim/RunOptions.h"
 #include "sim/StatsReport.h"
@@ -32,9 +37,11 @@ struct Compiled {
   std::unique_ptr<QdotModel, void (*)(QdotModel*)> model{nullptr, nullptr};
   rt::ExperimentDefaults experiment;
   double compileSeconds = 0;
+  double kernelSeconds = 0, codegenSeconds = 0;  ///< the last two stages of compileSeconds
+  driver::StageTimes times;                          ///< parse .. dae
 };
 
-Compiled compile(const std::string& file) {
+Compiled compile(const std::string& file, const std::string& backend) {
   driver::Compilation c;
   if (!driver::compileFile(c, file, "", driver::Stage::Dae)) {
     c.diags.render(std::cerr, c.sources);
@@ -44,13 +51,26 @@ Compiled compile(const std::string& file) {
   auto t0 = Clock::now();
   kernel::KernelModule kernels = kernel::buildKernels(*c.dae, c.ctx);
   if (!kernels.errors.empty()) throw std::runtime_error(kernels.errors.front());
-  bc::Module module = bytecode::emitBytecode(kernels, c.sources);
+  out.kernelSeconds = secondsSince(t0);
+  t0 = Clock::now();
   std::string error;
-  QdotModel* model = vm::createModel(module, error);
+  QdotModel* model = nullptr;
+  if (backend == "llvm") {
+#ifdef QDOT_BENCH_LLVM
+    model = llvmbackend::createJitModel(kernels, c.sources, 2, error);
+#else
+    throw std::runtime_error("built without the LLVM backend");
+#endif
+  } else {
+    bc::Module module = bytecode::emitBytecode(kernels, c.sources);
+    model = vm::createModel(module, error);
+  }
   if (!model) throw std::runtime_error(error);
+  out.codegenSeconds = secondsSince(t0);
   out.model = {model, model->destroy};
   const auto& t = c.times;
-  out.compileSeconds = t.parse + t.check + t.flatten + t.derive + t.dae + secondsSince(t0);
+  out.times = t;
+  out.compileSeconds = t.parse + t.check + t.flatten + t.derive + t.dae + out.kernelSeconds + out.codegenSeconds;
   const auto& e = c.dae->experiment;
   out.experiment = {e.startTime, e.stopTime, e.interval, e.tolerance};
   return out;
@@ -105,7 +125,10 @@ void writeJson(const std::string& path, const Compiled& c, const rt::SimulationR
   out.precision(17);
   out << "{\"solve\": " << *std::min_element(solves.begin(), solves.end()) << ", \"solves\": [";
   for (std::size_t i = 0; i < solves.size(); ++i) out << (i ? ", " : "") << solves[i];
-  out << "], \"setup\": " << r.setupSeconds << ", \"compile\": " << c.compileSeconds << ", \"steps\": " << s.steps
+  const auto& t = c.times;
+  out << "], \"setup\": " << r.setupSeconds << ", \"compile\": " << c.compileSeconds << ", \"stages\": {\"parse\": "
+      << t.parse << ", \"check\": " << t.check << ", \"flatten\": " << t.flatten << ", \"derive\": " << t.derive
+      << ", \"dae\": " << t.dae << ", \"kernel\": " << c.kernelSeconds << ", \"codegen\": " << c.codegenSeconds << "}" << ", \"steps\": " << s.steps
       << ", \"residuals\": " << s.residualEvaluations << ", \"jacobians\": " << s.jacobianEvaluations
       << ", \"iterations\": " << s.nonlinearIterations << ", \"errorTestFailures\": " << s.errorTestFailures
       << ", \"convergenceFailures\": " << s.convergenceFailures << ", \"rows\": " << r.rows
@@ -123,19 +146,21 @@ void writeJson(const std::string& path, const Compiled& c, const rt::SimulationR
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"qdot run --backend bytecode in-process, timing the solve at full precision (bench/)"};
-  std::string file, json;
+  CLI::App app{"qdot run --backend bytecode|llvm in-process, timing the solve at full precision (bench/)"};
+  std::string file, json, backend = "bytecode";
   int repeat = 1;
   bool breakdown = false;
   rt::RunOptions options;
   app.add_option("file", file, "the model file (.qd)")->required()->check(CLI::ExistingFile);
+  app.add_option("--backend", backend, "bytecode (the VM, default) or llvm (the JIT), as qdot run")
+      ->check(CLI::IsMember({"bytecode", "llvm"}));
   app.add_option("--repeat", repeat, "simulate this many times, report the fastest solve")->check(CLI::PositiveNumber);
   app.add_flag("--breakdown", breakdown, "one more run timing the model's residual and Jacobian");
   app.add_option("--json", json, "write the counters and times as JSON to this file");
   rt::addRunOptions(app, options);
   CLI11_PARSE(app, argc, argv);
   try {
-    Compiled c = compile(file);
+    Compiled c = compile(file, backend);
     rt::ResolvedRun run = rt::resolveRunOptions(options, c.experiment, *c.model);
     rt::SimulationResult result;
     std::vector<double> solves;

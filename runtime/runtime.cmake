@@ -9,3 +9,12 @@ target_link_libraries(qdot_runtime
   PUBLIC fmt::fmt CLI11::CLI11
   PRIVATE SUNDIALS::ida_shared SUNDIALS::nvecserial_shared SUNDIALS::sunmatrixdense_shared
           SUNDIALS::sunmatrixsparse_shared SUNDIALS::sunlinsoldense_shared SUNDIALS::sunlinsolklu_shared)
+
+# qdot_exe_main: the main of standalone model executables (exe/, `qdot build`). qdot links it,
+# with qdot_runtime, qdot_vm and the shared SUNDIALS and fmt libraries, to a generated source file
+# holding the model (exe/Embedded.h); the paths are compiled into qdot (compiler/driver).
+file(GLOB EXE_MAIN_SOURCES CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/exe/*.cpp)
+if(EXE_MAIN_SOURCES)
+  add_library(qdot_exe_main STATIC ${EXE_MAIN_SOURCES})
+  target_link_libraries(qdot_exe_main PUBLIC qdot_runtime qdot_vm)
+endif()

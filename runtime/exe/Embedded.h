@@ -1,0 +1,24 @@
+// The symbols `qdot build` generates for a standalone executable (one source file per model):
+// the serialised bytecode module (bc::serialize), the model's experiment annotation and, with
+// --backend llvm, the compiled programs (an object file emitted by compiler/llvm/ObjectFile.h).
+#pragma once
+
+#include <cstdint>
+
+extern "C" {
+extern const uint8_t qdot_model_bytes[];
+extern const uint64_t qdot_model_size;
+/// start, stop, interval, tolerance; a value counts only where qdot_experiment_given is 1.
+extern const double qdot_experiment_values[4];
+extern const uint8_t qdot_experiment_given[4];
+
+/// A compiled kernel program (compiler/llvm/Jit.h, ProgramFn): tcj = {t, cj}, y, yp, p, given,
+/// overridden, out, spill.
+typedef void (*qdot_program_fn)(const double* tcj, const double* y, const double* yp, const double* p,
+                                const double* given, const uint8_t* overridden, double* out, double* spill);
+/// Per kernel program (parameters, initialValues, residual, jacobian, outputs, invariants): the
+/// native code, or all null when the model runs on the VM.
+extern const qdot_program_fn qdot_native_programs[6];
+/// Doubles of spill memory each native program needs.
+extern const uint32_t qdot_native_spill[6];
+}

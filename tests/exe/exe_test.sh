@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# qdot build, with either backend (llvm, the default, and bytecode): the executable writes the
+# same CSV as `qdot run` with the same backend, lists the parameters in --help, needs no LLVM at
+# run time, exits 2 on a bad command line and 3 with the model's error when the run fails.
+# Usage: exe_test.sh QDOT_BINARY SOURCE_DIR WORK_DIR
+set -u
+qdot=$1
+src=$2
+work=$3
+fail=0
+pass=0
+ok() { pass=$((pass + 1)); }
+bad() { echo "FAIL $*"; fail=$((fail + 1)); }
+check() {  # check NAME EXPECTED_EXIT COMMAND...
+  local name=$1 want=$2
+  shift 2
+  "$@" >"$work/out.txt" 2>&1
+  local got=$?
+  if [ "$got" -eq "$want" ]; then ok; else bad "$name: exit $got, expected $want"; sed 's/^/    /' "$work/out.txt"; fi
+}
+same() {  # same NAME FILE1 FILE2
+  if [ -s "$2" ] && cmp -s "$2" "$3"; then ok; else bad "$1: $2 and $3 differ"; diff "$2" "$3" | head -5; fi
+}
+
+mkdir -p "$work"
+utube=$src/examples/textbook/utube.qd
+for backend in llvm bytecode; do
+  exe=$work/utube-$backend
+  rm -f "$exe"
+  check "build-$backend" 0 "$qdot" build "$utube" -o "$exe" --backend $backend
+  [ -x "$exe" ] && ok || bad "build: no executable $exe"
+
+  # Same CSV as qdot run: overridden parameter and stop time, the experiment annotation's defaults,
+  # selected columns with invariants, -o FILE.
+  "$exe" --stop 5 -p h=0.2 >"$work/$backend-exe.csv"
+  "$qdot" run "$utube" --backend $backend --stop 5 -p h=0.2 >"$work/$backend-run.csv"
+  same csv-p-$backend "$work/$backend-exe.csv" "$work/$backend-run.csv"
+  "$exe" >"$work/$backend-exe-default.csv"
+  "$qdot" run "$utube" --backend $backend >"$work/$backend-run-default.csv"
+  same csv-experiment-$backend "$work/$backend-exe-default.csv" "$work/$backend-run-default.csv"
+  "$exe" --stop 2 --interval 0.1 --rtol 1e-8 --invariants --outputs x,jacobi -o "$work/$backend-exe-o.csv"
+  "$qdot" run "$utube" --backend $backend --stop 2 --interval 0.1 --rtol 1e-8 --invariants --outputs x,jacobi -o "$work/$backend-run-o.csv"
+  same csv-outputs-$backend "$work/$backend-exe-o.csv" "$work/$backend-run-o.csv"
+
+  # --help: every parameter with its default and description.
+  check help-$backend 0 "$exe" --help
+  for line in "rho = 1000" "A = 0.0001" "l = 1" "g = 9.81" "h = 0.1" "density [kg/m3]" "initial level difference [m]" \
+    "--stop" "--linear-solver"; do
+    grep -qF -- "$line" "$work/out.txt" && ok || bad "help: no '$line'"
+done
+
+# No LLVM at run time.
+if ldd "$exe" >"$work/ldd.txt" 2>&1; then
+  grep -qi llvm "$work/ldd.txt" && bad "ldd: the executable needs LLVM" || ok
+  grep -q "not found" "$work/ldd.txt" && bad "ldd: a library is missing" || ok
+else
+  bad "ldd failed"
+fi
+
+# Command-line mistakes: exit 2, as qdot run.
+check bad-parameter 2 "$exe" -p nope=1
+check bad-value 2 "$exe" -p h=abc
+check no-equals 2 "$exe" -p h
+check bad-option 2 "$exe" --bogus
+check bad-stop 2 "$exe" --stop -1
+grep -qF "did you mean" <("$exe" -p hh=1 2>&1) && ok || bad "bad-parameter: no suggestion"
+
+# A run that fails: exit 3 and the same error sentence as qdot run.
+"$qdot" build "$src/tests/exe/sqrt_fails.qd" -o "$work/fails-$backend" --backend $backend
+"$work/fails-$backend" >/dev/null 2>"$work/$backend-exe-err.txt"
+[ $? -eq 3 ] && ok || bad "fails-$backend: exit code"
+"$qdot" run "$src/tests/exe/sqrt_fails.qd" --backend $backend >/dev/null 2>"$work/$backend-run-err.txt"
+same "fails-$backend-message" "$work/$backend-exe-err.txt" "$work/$backend-run-err.txt"
+grep -qF "sqrt of a negative number" "$work/$backend-exe-err.txt" && ok || bad "fails-$backend: no diagnosis"
+done
+
+# The default backend is llvm.
+check build-default 0 "$qdot" build "$utube" -o "$work/utube-default"
+"$work/utube-default" --stop 1 >"$work/default-exe.csv"
+"$qdot" run "$utube" --backend llvm --stop 1 >"$work/default-run.csv"
+same csv-default-backend "$work/default-exe.csv" "$work/default-run.csv"
+
+# qdot build's own mistakes.
+check build-no-output 2 "$qdot" build "$utube"
+check build-bad-backend 2 "$qdot" build "$utube" -o "$work/x" --backend jvm
+check build-missing-file 2 "$qdot" build "$src/does/not/exist.qd" -o "$work/x"
+check build-model-error 1 "$qdot" build "$src/tests/diagnostics/unknown_name.qd" -o "$work/x"
+[ -e "$work/x" ] && bad "build-model-error: wrote an executable" || ok
+
+echo "$pass passed, $fail failed"
+[ "$fail" -eq 0 ]
