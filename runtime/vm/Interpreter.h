@@ -6,19 +6,13 @@
 #include <string>
 
 #include "qdot/bytecode.h"
+#include "qdot/model_adapter.hpp"
 
 namespace qdot::vm {
 
-/// What a function may read. Pointers a function does not use may be null (the validator
-/// guarantees each function loads only what its ABI entry point passes).
-struct Inputs {
-  double t = 0, cj = 0;
-  const double* y = nullptr;
-  const double* yp = nullptr;
-  const double* p = nullptr;
-  const double* given = nullptr;
-  const uint8_t* overridden = nullptr;
-};
+/// What a function may read (the ABI adapter's call record). Pointers a function does not use may
+/// be null (the validator guarantees each function loads only what its ABI entry point passes).
+using Inputs = ModelCall;
 
 /// Runs f. `registers` has f.registerCount entries with the constant pool preloaded in
 /// [0, f.constants.size()); out has f.outputCount entries.

@@ -1,0 +1,116 @@
+// ModelAdapter: the QdotModel entry points (parameters, start values, residual, Jacobian, outputs,
+// invariants, lastError, destroy) for any backend that can run "program k on these inputs". The VM
+// and the LLVM JIT implement only `run`; the ABI glue (default parameter inputs, splitting the start
+// values, argument plumbing) lives here once.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "qdot/model_abi.h"
+#include "qdot/model_table.hpp"
+
+namespace qdot {
+
+/// The inputs of one call of a compiled program (unused ones stay null/0).
+struct ModelCall {
+  double t = 0, cj = 0;
+  const double* y = nullptr;
+  const double* yp = nullptr;
+  const double* p = nullptr;
+  const double* given = nullptr;
+  const uint8_t* overridden = nullptr;
+};
+
+/// The programs in model-ABI order (kernel::ProgramId and bc::FunctionId number them the same).
+enum class ModelProgram : uint8_t { Parameters, InitialValues, Residual, Jacobian, Outputs, Invariants };
+
+/// State every adapted model carries next to its backend data.
+struct AdaptedModel : QdotModel {
+  ModelNameTable names;                      ///< what the table's name arrays point into
+  const int32_t* fixedFlags = nullptr;       ///< [nVariables], owned by the backend's module
+  std::vector<double> noneGiven;             ///< used when the runtime passes no given values
+  std::vector<uint8_t> noneOverridden;
+  mutable std::vector<double> startScratch;  ///< [y0 | yp0 | nominal]
+  mutable std::string error;                 ///< lastError
+};
+
+/// `Model` derives from AdaptedModel and has `int run(ModelProgram, const ModelCall&, double* out) const`
+/// returning nonzero (with `error` set) when an output is not finite.
+template <class Model>
+struct ModelAdapter {
+  /// Fills the table of `m` from `module` (names, pattern) and points its functions here.
+  template <class Module>
+  static void install(Model& m, const Module& module) {
+    fillModelTable(m, m.names, module);
+    m.fixedFlags = module.fixed.data();
+    m.noneGiven.assign(m.nParameters, 0.0);
+    m.noneOverridden.assign(m.nParameters, 0);
+    m.startScratch.assign(3 * size_t{m.nVariables}, 0.0);
+    m.parameters = parameters, m.initialValues = initialValues, m.fixedStarts = fixedStarts;
+    m.residual = residual, m.jacobian = jacobian, m.outputs = outputs, m.invariants = invariants;
+    m.lastError = lastError, m.destroy = destroy;
+  }
+
+ private:
+  static const Model& self(const QdotModel* s) { return *static_cast<const Model*>(s); }
+
+  static ModelCall state(double t, const double* y, const double* yp, const double* p) {
+    ModelCall c;
+    c.t = t, c.y = y, c.yp = yp, c.p = p;
+    return c;
+  }
+
+  static int parameters(const QdotModel* s, const double* given, const uint8_t* overridden, double* p) {
+    const Model& m = self(s);
+    ModelCall c;
+    c.given = given ? given : m.noneGiven.data();
+    c.overridden = overridden ? overridden : m.noneOverridden.data();
+    return m.run(ModelProgram::Parameters, c, p);
+  }
+
+  static int initialValues(const QdotModel* s, const double* p, double t0, double* y0, double* yp0, double* nominal) {
+    const Model& m = self(s);
+    ModelCall c;
+    c.t = t0, c.p = p;
+    int rc = m.run(ModelProgram::InitialValues, c, m.startScratch.data());
+    const double* v = m.startScratch.data();
+    size_t n = m.nVariables;
+    if (y0) std::copy(v, v + n, y0);
+    if (yp0) std::copy(v + n, v + 2 * n, yp0);
+    if (nominal) std::copy(v + 2 * n, v + 3 * n, nominal);
+    return rc;
+  }
+
+  static int fixedStarts(const QdotModel* s, int32_t* fixed) {
+    std::copy(self(s).fixedFlags, self(s).fixedFlags + s->nVariables, fixed);
+    return 0;
+  }
+
+  static int residual(const QdotModel* s, double t, const double* y, const double* yp, const double* p, double* F) {
+    return self(s).run(ModelProgram::Residual, state(t, y, yp, p), F);
+  }
+
+  static int jacobian(const QdotModel* s, double t, const double* y, const double* yp, const double* p, double cj,
+                      double* values) {
+    ModelCall c = state(t, y, yp, p);
+    c.cj = cj;
+    return self(s).run(ModelProgram::Jacobian, c, values);
+  }
+
+  static int outputs(const QdotModel* s, double t, const double* y, const double* yp, const double* p, double* out) {
+    return self(s).run(ModelProgram::Outputs, state(t, y, yp, p), out);
+  }
+
+  static int invariants(const QdotModel* s, double t, const double* y, const double* yp, const double* p,
+                        double* out) {
+    return self(s).run(ModelProgram::Invariants, state(t, y, yp, p), out);
+  }
+
+  static const char* lastError(const QdotModel* s) { return self(s).error.c_str(); }
+  static void destroy(QdotModel* s) { delete static_cast<Model*>(s); }
+};
+
+}  // namespace qdot
