@@ -16,39 +16,18 @@
 #include <string>
 
 #include "bytecode/Emitter.h"
-#include "dae/Dae.h"
-#include "flatten/Flatten.h"
+#include "unit/common/SourceDae.h"
 #include "kernel/Kernel.h"
-#include "mechanics/EulerLagrange.h"
-#include "sema/Sema.h"
-#include "syntax/Parser.h"
 #include "vm/Vm.h"
 
 namespace qdot::test {
 
-inline std::string readFile(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-class SourceModel {
+class SourceModel : public SourceDae {
  public:
   /// Compiles `text` (named `name` in locations) down to a VM model; fails the test on errors.
-  SourceModel(const std::string& name, const std::string& text) {
-    uint32_t file = sources.addBuffer(name, text);
-    ast = syntax::parse(sources, file, diags);
-    if (!diags.hasErrors()) checked = sema::checkModel(*ast, "", diags);
-    if (checked && !diags.hasErrors()) flat = flat::flatten(*checked, ctx, diags);
-    if (flat) eom = mech::deriveEquationsOfMotion(*flat, ctx, diags);
-    if (eom) dae = dae::buildDae(*flat, *eom, ctx, diags);
-    std::ostringstream rendered;
-    diags.render(rendered, sources);
-    if (!dae || diags.hasErrors()) {
-      ADD_FAILURE() << name << ":\n" << rendered.str();
-      return;
-    }
+  SourceModel(const std::string& name, const std::string& text)
+      : SourceDae(name, text) {
+    if (!dae) return;
     kernel = kernel::buildKernels(*dae, ctx);
     module = bytecode::emitBytecode(kernel, sources);
     std::string error;
@@ -74,14 +53,6 @@ class SourceModel {
     return v;
   }
 
-  SourceManager sources;
-  DiagnosticEngine diags;
-  sym::Context ctx;
-  std::unique_ptr<ast::StoredDefinition> ast;
-  std::optional<sema::CheckedModel> checked;
-  std::optional<flat::FlatModel> flat;
-  std::optional<mech::EquationsOfMotion> eom;
-  std::optional<dae::Dae> dae;
   kernel::KernelModule kernel;
   bc::Module module;
   QdotModel* model = nullptr;

@@ -12,39 +12,18 @@
 #include <sstream>
 #include <string>
 
-#include "dae/Dae.h"
-#include "flatten/Flatten.h"
+#include "unit/common/SourceDae.h"
 #include "kernel/Kernel.h"
 #include "llvm/JitModel.h"
-#include "mechanics/EulerLagrange.h"
-#include "sema/Sema.h"
-#include "syntax/Parser.h"
 
 namespace qdot::test {
 
-inline std::string readFile(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-class KernelSource {
+class KernelSource : public SourceDae {
  public:
   /// Compiles `text` (named `name` in locations) to kernels and a JIT model; fails the test on errors.
-  KernelSource(const std::string& name, const std::string& text, llvmbackend::JitOptions options = {}) {
-    uint32_t file = sources.addBuffer(name, text);
-    ast = syntax::parse(sources, file, diags);
-    if (!diags.hasErrors()) checked = sema::checkModel(*ast, "", diags);
-    if (checked && !diags.hasErrors()) flat = flat::flatten(*checked, ctx, diags);
-    if (flat) eom = mech::deriveEquationsOfMotion(*flat, ctx, diags);
-    if (eom) dae = dae::buildDae(*flat, *eom, ctx, diags);
-    std::ostringstream rendered;
-    diags.render(rendered, sources);
-    if (!dae || diags.hasErrors()) {
-      ADD_FAILURE() << name << ":\n" << rendered.str();
-      return;
-    }
+  KernelSource(const std::string& name, const std::string& text, llvmbackend::JitOptions options = {})
+      : SourceDae(name, text) {
+    if (!dae) return;
     kernel = kernel::buildKernels(*dae, ctx);
     std::string error;
     model = llvmbackend::createJitModel(kernel, sources, options, error, &stats);
@@ -56,14 +35,6 @@ class KernelSource {
   }
   bool ok() const { return model != nullptr; }
 
-  SourceManager sources;
-  DiagnosticEngine diags;
-  sym::Context ctx;
-  std::unique_ptr<ast::StoredDefinition> ast;
-  std::optional<sema::CheckedModel> checked;
-  std::optional<flat::FlatModel> flat;
-  std::optional<mech::EquationsOfMotion> eom;
-  std::optional<dae::Dae> dae;
   kernel::KernelModule kernel;
   llvmbackend::JitStats stats;
   QdotModel* model = nullptr;
