@@ -30,7 +30,7 @@ struct Options {
   bool json = false;
   std::string emit;
   bool timings = false;
-  std::string backend = "bytecode";
+  std::string backend = "llvm";
   rt::RunOptions run;
   std::string exePath;  // qdot build -o
   std::string buildBackend = "llvm";  // qdot build --backend
@@ -69,11 +69,34 @@ int runEquations(const Options& o) {
   return finish(c, ok);
 }
 
+// What the JIT compiles for one run: residual, Jacobian and outputs always, the invariants only
+// when they are asked for; parameters and start values run once, on the kernel interpreter.
+llvmbackend::JitOptions jitOptionsFor(const rt::RunOptions& run) {
+  llvmbackend::JitOptions options;
+  if (!run.invariants) options.compiledPrograms &= ~llvmbackend::programBit(kernel::ProgramId::Invariants);
+  return options;
+}
+
+// --stats: the time of every compile stage, and how the JIT compiled.
+void printCompileStats(const driver::StageTimes& t, double kernel, const std::string& backend, double codegen,
+                       const llvmbackend::JitStats* jit) {
+  double total = t.parse + t.check + t.flatten + t.derive + t.dae + kernel + codegen;
+  std::cerr << "compile [ms]: parse " << t.parse * 1e3 << ", check " << t.check * 1e3 << ", flatten "
+            << t.flatten * 1e3 << ", derive " << t.derive * 1e3 << ", dae " << t.dae * 1e3 << ", kernel "
+            << kernel * 1e3 << ", codegen (" << backend << ") " << codegen * 1e3 << "; total " << total * 1e3 << "\n";
+  if (!jit) return;
+  uint32_t functions = 0;
+  for (uint32_t f : jit->functions) functions += f;
+  std::cerr << "jit: " << functions << " functions in " << jit->units << " modules on " << jit->threads
+            << " threads; lower " << jit->lowerSeconds * 1e3 << " ms, machine code " << jit->codegenSeconds * 1e3
+            << " ms (summed over threads), link " << jit->linkSeconds * 1e3 << " ms\n";
+}
+
 rt::ExperimentDefaults experimentOf(const dae::Dae& d) {
   return {d.experiment.startTime, d.experiment.stopTime, d.experiment.interval, d.experiment.tolerance};
 }
 
-// Compiles to bytecode and simulates on the VM. Exit codes: 0, 1 (model errors), 2 (usage),
+// Compiles (JIT by default, or bytecode for the VM) and simulates. Exit codes: 0, 1 (model errors), 2 (usage),
 // 3 (the solver or the model failed during the run; the rows computed so far are kept).
 int runSimulate(const Options& o) {
   driver::Compilation c;
@@ -88,11 +111,17 @@ int runSimulate(const Options& o) {
     return finish(c, true);
   }
   t0 = std::chrono::steady_clock::now();
-  std::string error;
+  std::string error, backend = o.emit.empty() ? o.backend : "bytecode";
   QdotModel* model = nullptr;
-  if (o.backend == "llvm" && o.emit.empty()) {
-    model = llvmbackend::createJitModel(kernels, c.sources, 2, error);
-  } else {
+  llvmbackend::JitStats jit;
+  if (backend == "llvm") {
+    model = llvmbackend::createJitModel(kernels, c.sources, jitOptionsFor(o.run), error, &jit);
+    if (!model) {
+      std::cerr << "qdot: warning: the LLVM JIT failed (" << error << "); running on the bytecode VM instead\n";
+      backend = "bytecode";
+    }
+  }
+  if (!model) {
     bc::Module module = bytecode::emitBytecode(kernels, c.sources);
     if (o.emit == "bytecode") {
       vm::disassemble(std::cout, module);
@@ -103,15 +132,10 @@ int runSimulate(const Options& o) {
   double codegenSeconds = secondsSince(t0);
   if (!model) {
     std::cerr << "qdot: internal error: " << error << "\n";
-    return 1;
+    return 4;
   }
   c.diags.render(std::cerr, c.sources, isatty(2));  // warnings, if any
-  if (o.run.stats) {
-    const auto& t = c.times;
-    std::cerr << "compile [ms]: parse " << t.parse * 1e3 << ", check " << t.check * 1e3 << ", flatten "
-              << t.flatten * 1e3 << ", derive " << t.derive * 1e3 << ", dae " << t.dae * 1e3 << ", kernel "
-              << kernelSeconds * 1e3 << ", codegen (" << o.backend << ") " << codegenSeconds * 1e3 << "\n";
-  }
+  if (o.run.stats) printCompileStats(c.times, kernelSeconds, backend, codegenSeconds, backend == "llvm" ? &jit : nullptr);
   int code = rt::runModel(*model, o.run, experimentOf(*c.dae), std::cout, std::cerr);
   model->destroy(model);
   return code;
@@ -272,7 +296,7 @@ int main(int argc, char** argv) {
   auto* run = app.add_subcommand("run", "Simulate a model with SUNDIALS IDA and write the results as CSV");
   run->add_option("file", o.file, "the model file (.qd)")->required()->check(CLI::ExistingFile);
   run->add_option("--model", o.model, "the model (default: the last model in the file)");
-  run->add_option("--backend", o.backend, "code generator: bytecode (the VM, default) or llvm (JIT)")
+  run->add_option("--backend", o.backend, "code generator: llvm (native code by the in-process JIT, default) or bytecode (the VM: no compile time)")
       ->check(CLI::IsMember({"bytecode", "llvm"}));
   run->add_option("--emit", o.emit, "print a stage's output instead of running: kernel, bytecode")
       ->check(CLI::IsMember({"kernel", "bytecode"}));

@@ -12,6 +12,8 @@
 // No fast-math flags are set anywhere, so LLVM may not reassociate or contract.
 #include "llvm/Codegen.h"
 
+#include <unordered_map>
+
 #include <llvm/IR/IRBuilder.h>
 #include <llvm/IR/Intrinsics.h>
 #include <llvm/IR/LLVMContext.h>
@@ -55,96 +57,56 @@ uint32_t operand(const Instr& ins, unsigned i) { return i == 0 ? ins.a : i == 1 
 /// The arguments of every generated function, in ProgramFn order.
 enum Arg : unsigned { kTimeCj, kY, kYp, kP, kGiven, kOverridden, kOut, kSpill, kArgCount };
 
-/// Lowers one program, possibly into several functions.
-class ProgramLowering {
- public:
-  ProgramLowering(const kernel::Program& p, llvm::Module& m, uint32_t maxInstructions)
-      : prog_(p), mod_(m), b_(m.getContext()), dbl_(b_.getDoubleTy()), chunk_(std::max<uint32_t>(1, maxInstructions)) {}
+llvm::Function* declareProgramFunction(llvm::Module& m, const std::string& name, bool internal) {
+  llvm::LLVMContext& c = m.getContext();
+  auto* ptr = llvm::PointerType::getUnqual(c);
+  std::vector<llvm::Type*> params(kArgCount, ptr);
+  auto* type = llvm::FunctionType::get(llvm::Type::getVoidTy(c), params, false);
+  auto linkage = internal ? llvm::GlobalValue::InternalLinkage : llvm::GlobalValue::ExternalLinkage;
+  auto* f = llvm::Function::Create(type, linkage, name, m);
+  f->addFnAttr(llvm::Attribute::NoUnwind);
+  for (unsigned a = 0; a < kArgCount; ++a) {
+    f->addParamAttr(a, llvm::Attribute::NoCapture);
+    if (a == kOut || a == kSpill) f->addParamAttr(a, llvm::Attribute::NoAlias);
+    else f->addParamAttr(a, llvm::Attribute::ReadOnly);
+  }
+  return f;
+}
 
-  /// Emits the entry function `name`; returns {functions, spill slots}.
-  std::pair<uint32_t, uint32_t> lower(const std::string& name) {
-    size_t n = prog_.code.size();
-    uint32_t parts = n <= chunk_ ? 1 : static_cast<uint32_t>((n + chunk_ - 1) / chunk_);
-    assignSpillSlots();
-    if (parts == 1) {
-      emitPart(declare(name, llvm::GlobalValue::ExternalLinkage), 0, n);
-      return {1, spillCount_};
+/// Lowers one part of a program (instructions [begin, end)) into one function: one basic block.
+/// Registers defined in the part are SSA values; an earlier part's register is either redone (a
+/// load or constant) or reloaded from its spill slot, once per part.
+class PartLowering {
+ public:
+  PartLowering(const kernel::Program& p, const ProgramSplit& split, llvm::Function* f, size_t begin, size_t end)
+      : prog_(p), split_(split), mod_(*f->getParent()), b_(f->getContext()), dbl_(b_.getDoubleTy()), fn_(f),
+        begin_(begin), end_(end), local_(end - begin, nullptr) {}
+
+  void emit() {
+    b_.SetInsertPoint(llvm::BasicBlock::Create(mod_.getContext(), "entry", fn_));
+    for (size_t i = begin_; i < end_; ++i) {
+      llvm::Value* v = emit(prog_.code[i]);
+      local_[i - begin_] = v;
+      if (split_.spillSlot[i] != ProgramSplit::kNoSlot) b_.CreateStore(v, elementPtr(kSpill, split_.spillSlot[i], dbl_));
     }
-    std::vector<llvm::Function*> fns;
-    for (uint32_t k = 0; k < parts; ++k) {
-      llvm::Function* f = declare(name + "." + std::to_string(k), llvm::GlobalValue::InternalLinkage);
-      f->addFnAttr(llvm::Attribute::NoInline);
-      emitPart(f, size_t(k) * chunk_, std::min(n, size_t(k + 1) * chunk_));
-      fns.push_back(f);
-    }
-    emitCaller(declare(name, llvm::GlobalValue::ExternalLinkage), fns);
-    return {parts, spillCount_};
+    b_.CreateRetVoid();
   }
 
  private:
-  uint32_t partOf(size_t i) const { return static_cast<uint32_t>(i / chunk_); }
-
-  // A value used in a later part than the one defining it gets a slot (unless it is a load).
-  void assignSpillSlots() {
-    spillSlot_.assign(prog_.code.size(), UINT32_MAX);
-    for (size_t i = 0; i < prog_.code.size(); ++i) {
-      const Instr& ins = prog_.code[i];
-      for (unsigned j = 0, e = operandCount(ins.op); j < e; ++j) {
-        uint32_t v = operand(ins, j);
-        if (partOf(v) != partOf(i) && !rematerialisable(prog_.code[v].op) && spillSlot_[v] == UINT32_MAX)
-          spillSlot_[v] = spillCount_++;
-      }
-    }
-  }
-
-  llvm::Function* declare(const std::string& name, llvm::GlobalValue::LinkageTypes linkage) {
-    auto* ptr = llvm::PointerType::getUnqual(mod_.getContext());
-    std::vector<llvm::Type*> params(kArgCount, ptr);
-    auto* type = llvm::FunctionType::get(b_.getVoidTy(), params, false);
-    auto* f = llvm::Function::Create(type, linkage, name, mod_);
-    f->addFnAttr(llvm::Attribute::NoUnwind);
-    for (unsigned a = 0; a < kArgCount; ++a) {
-      f->addParamAttr(a, llvm::Attribute::NoCapture);
-      if (a == kOut || a == kSpill) f->addParamAttr(a, llvm::Attribute::NoAlias);
-      else f->addParamAttr(a, llvm::Attribute::ReadOnly);
-    }
-    return f;
-  }
-
-  void emitCaller(llvm::Function* entry, const std::vector<llvm::Function*>& parts) {
-    b_.SetInsertPoint(llvm::BasicBlock::Create(mod_.getContext(), "entry", entry));
-    std::vector<llvm::Value*> args;
-    for (auto& a : entry->args()) args.push_back(&a);
-    for (llvm::Function* f : parts) b_.CreateCall(f, args);
-    b_.CreateRetVoid();
-  }
-
-  // Instructions [begin, end) into f: one basic block.
-  void emitPart(llvm::Function* f, size_t begin, size_t end) {
-    fn_ = f;
-    b_.SetInsertPoint(llvm::BasicBlock::Create(mod_.getContext(), "entry", f));
-    ++part_;  // invalidates the values of the previous part
-    if (values_.empty()) values_.assign(prog_.code.size(), {nullptr, 0});
-    for (size_t i = begin; i < end; ++i) {
-      llvm::Value* v = emit(prog_.code[i]);
-      values_[i] = {v, part_};
-      if (spillSlot_[i] != UINT32_MAX) b_.CreateStore(v, elementPtr(kSpill, spillSlot_[i], dbl_));
-    }
-    b_.CreateRetVoid();
-  }
-
   llvm::Value* elementPtr(Arg a, uint32_t index, llvm::Type* type) {
     return b_.CreateConstInBoundsGEP1_64(type, fn_->getArg(a), index);
   }
   llvm::Value* loadInput(Arg a, uint32_t index) { return b_.CreateLoad(dbl_, elementPtr(a, index, dbl_)); }
 
-  // Register %v in the current part: its value, a redone load, or a reload from the spill array.
+  // Register %v in this part: its value, a redone load, or a reload from the spill array.
   llvm::Value* value(uint32_t v) {
-    if (values_[v].second == part_) return values_[v].first;
-    const Instr& def = prog_.code[v];
-    llvm::Value* x = rematerialisable(def.op) ? emit(def) : b_.CreateLoad(dbl_, elementPtr(kSpill, spillSlot_[v], dbl_));
-    values_[v] = {x, part_};
-    return x;
+    if (v >= begin_) return local_[v - begin_];
+    auto [it, fresh] = imported_.try_emplace(v, nullptr);
+    if (fresh) {
+      const Instr& def = prog_.code[v];
+      it->second = rematerialisable(def.op) ? emit(def) : b_.CreateLoad(dbl_, elementPtr(kSpill, split_.spillSlot[v], dbl_));
+    }
+    return it->second;
   }
 
   llvm::Value* boolean(llvm::Value* cond) {
@@ -245,18 +207,54 @@ class ProgramLowering {
   }
 
   const kernel::Program& prog_;
+  const ProgramSplit& split_;
   llvm::Module& mod_;
   llvm::IRBuilder<> b_;
   llvm::Type* dbl_;
-  uint32_t chunk_;
-  llvm::Function* fn_ = nullptr;
-  std::vector<std::pair<llvm::Value*, uint32_t>> values_;  // value and the part it belongs to
-  uint32_t part_ = 0;                                       // 1 + index of the part being emitted
-  std::vector<uint32_t> spillSlot_;
-  uint32_t spillCount_ = 0;
+  llvm::Function* fn_;
+  size_t begin_, end_;
+  std::vector<llvm::Value*> local_;                       // values of [begin_, end_)
+  std::unordered_map<uint32_t, llvm::Value*> imported_;  // earlier parts' values used here
 };
 
+void emitCaller(llvm::Function* entry, const std::vector<llvm::Function*>& parts) {
+  llvm::IRBuilder<> b(llvm::BasicBlock::Create(entry->getContext(), "entry", entry));
+  std::vector<llvm::Value*> args;
+  for (auto& a : entry->args()) args.push_back(&a);
+  for (llvm::Function* f : parts) b.CreateCall(f, args);
+  b.CreateRetVoid();
+}
+
 }  // namespace
+
+ProgramSplit splitProgram(const kernel::Program& p, uint32_t maxInstructions) {
+  ProgramSplit s;
+  size_t n = p.code.size();
+  s.chunk = std::max<uint32_t>(1, maxInstructions);
+  s.parts = static_cast<uint32_t>(std::max<size_t>(1, (n + s.chunk - 1) / s.chunk));
+  s.spillSlot.assign(n, ProgramSplit::kNoSlot);
+  auto partOf = [&](size_t i) { return i / s.chunk; };
+  for (size_t i = 0; i < n; ++i) {
+    const Instr& ins = p.code[i];
+    for (unsigned j = 0, e = operandCount(ins.op); j < e; ++j) {
+      uint32_t v = operand(ins, j);
+      if (partOf(v) != partOf(i) && !rematerialisable(p.code[v].op) && s.spillSlot[v] == ProgramSplit::kNoSlot)
+        s.spillSlot[v] = s.spillSlots++;
+    }
+  }
+  return s;
+}
+
+std::string partName(const std::string& name, uint32_t k) { return name + "." + std::to_string(k); }
+
+void lowerParts(const kernel::Program& p, const ProgramSplit& split, uint32_t first, uint32_t last,
+                const std::string& name, llvm::Module& m, bool internal) {
+  for (uint32_t k = first; k < last; ++k) {
+    llvm::Function* f = declareProgramFunction(m, partName(name, k), internal);
+    if (internal) f->addFnAttr(llvm::Attribute::NoInline);
+    PartLowering(p, split, f, split.begin(k), split.end(k, p.code.size())).emit();
+  }
+}
 
 std::string entryName(const kernel::Program& p, kernel::ProgramId id) {
   return "qdot_" + (p.name.empty() ? std::to_string(static_cast<int>(id)) : p.name);
@@ -267,10 +265,21 @@ LoweredModule lowerKernels(const kernel::KernelModule& k, llvm::LLVMContext& ctx
   out.module = std::make_unique<llvm::Module>("qdot." + k.name, ctx);
   for (size_t i = 0; i < kernel::kProgramCount; ++i) {
     auto id = static_cast<kernel::ProgramId>(i);
-    out.entryNames[i] = entryName(k.program(id), id);
-    auto [functions, slots] = ProgramLowering(k.program(id), *out.module, maxInstructions).lower(out.entryNames[i]);
-    out.functions[i] = functions;
-    out.spillSlots[i] = slots;
+    const kernel::Program& prog = k.program(id);
+    const std::string name = entryName(prog, id);
+    ProgramSplit split = splitProgram(prog, maxInstructions);
+    llvm::Function* entry = declareProgramFunction(*out.module, name, false);
+    if (split.parts == 1) {
+      PartLowering(prog, split, entry, 0, prog.code.size()).emit();
+    } else {
+      lowerParts(prog, split, 0, split.parts, name, *out.module, true);
+      std::vector<llvm::Function*> parts;
+      for (uint32_t p = 0; p < split.parts; ++p) parts.push_back(out.module->getFunction(partName(name, p)));
+      emitCaller(entry, parts);
+    }
+    out.entryNames[i] = name;
+    out.functions[i] = split.parts;
+    out.spillSlots[i] = split.spillSlots;
   }
   return out;
 }

@@ -1,11 +1,14 @@
-// The ORC JIT session of one model (internal to compiler/llvm): lowers a KernelModule, optimises
-// it with the new pass manager, compiles it in-process with LLJIT and hands out the entry points.
+// The ORC JIT session of one model (internal to compiler/llvm): lowers the programs of a
+// KernelModule in parallel units, compiles each to an object in memory, links them in-process
+// with LLJIT and hands out each program's functions.
 // No LLVM type in this header, so JitModel.cpp's ABI code stays plain C++.
 #pragma once
 
 #include <array>
 #include <memory>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "llvm/JitModel.h"
 
@@ -28,8 +31,9 @@ class JitSession {
   JitSession(const JitSession&) = delete;
   JitSession& operator=(const JitSession&) = delete;
 
-  /// Entry point of a program.
-  ProgramFn program(kernel::ProgramId id) const { return entries_[static_cast<size_t>(id)]; }
+  /// The functions of a program, to be called in order with one spill array; empty if the program
+  /// was not compiled (JitOptions::compiledPrograms).
+  std::span<const ProgramFn> program(kernel::ProgramId id) const { return parts_[static_cast<size_t>(id)]; }
   /// Doubles of spill memory the program needs.
   uint32_t spillSlots(kernel::ProgramId id) const { return spill_[static_cast<size_t>(id)]; }
 
@@ -37,7 +41,7 @@ class JitSession {
   struct Impl;
   JitSession();
   std::unique_ptr<Impl> impl_;
-  std::array<ProgramFn, kernel::kProgramCount> entries_{};
+  std::array<std::vector<ProgramFn>, kernel::kProgramCount> parts_;
   std::array<uint32_t, kernel::kProgramCount> spill_{};
 };
 

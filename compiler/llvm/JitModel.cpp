@@ -1,5 +1,6 @@
 // The model ABI on top of the JIT: one spill buffer per program; the entry points come from
-// ModelAdapter, this file only calls a compiled program and, if an output is not finite, re-runs it
+// ModelAdapter, this file only calls a compiled program (or interprets one that runs once per
+// simulation and was not worth compiling) and, if an output is not finite, re-runs it
 // on the kernel IR to say which equation produced it (Diagnose.h), stores that for lastError and
 // returns 1.
 #include "llvm/JitModel.h"
@@ -37,11 +38,15 @@ struct JitModel : AdaptedModel {
   std::unique_ptr<JitSession> session;
   mutable std::array<std::vector<double>, kernel::kProgramCount> spill;
 
-  /// Calls the compiled program; a non-finite result is traced on the kernel IR for lastError.
+  /// Calls the compiled program (its parts in order), or interprets one that was not compiled; a
+  /// non-finite result is traced on the kernel IR for lastError.
   int run(ModelProgram program, const Call& c, double* out) const {
     auto id = static_cast<ProgramId>(program);
     const double tcj[2] = {c.t, c.cj};
-    session->program(id)(tcj, c.y, c.yp, c.p, c.given, c.overridden, out, spill[static_cast<size_t>(id)].data());
+    double* scratch = spill[static_cast<size_t>(id)].data();
+    std::span<const ProgramFn> parts = session->program(id);
+    if (parts.empty()) kernel::interpret(kernels.program(id), kernelInputs(kernels, c), {out, kernels.program(id).outputCount});
+    for (ProgramFn part : parts) part(tcj, c.y, c.yp, c.p, c.given, c.overridden, out, scratch);
     uint32_t count = kernels.program(id).outputCount;
     for (uint32_t i = 0; i < count; ++i)
       if (!std::isfinite(out[i])) {

@@ -13,9 +13,18 @@
 
 namespace qdot::llvmbackend {
 
+/// Bit of kernel::ProgramId `id` in JitOptions::compiledPrograms.
+constexpr uint32_t programBit(kernel::ProgramId id) { return 1u << static_cast<unsigned>(id); }
+
 /// How to compile.
 struct JitOptions {
-  int optLevel = 2;  ///< code generator level 0-3 (0: fast instruction selection and register allocation)
+  /// Code generator level 0-3 of the hot programs, residual and Jacobian (0: fast instruction
+  /// selection and register allocation).
+  int optLevel = 2;
+  /// Level of the Jacobian; -1 = optLevel.
+  int jacobianOptLevel = -1;
+  /// Level of the other compiled programs (outputs, invariants: once per output row).
+  int coldOptLevel = 0;
   /// Programs longer than this (kernel instructions) are split into several LLVM functions so
   /// that compile time stays linear in the program size (LLVM is super-linear on huge blocks).
   uint32_t maxInstructionsPerFunction = 500;
@@ -26,14 +35,24 @@ struct JitOptions {
   /// Models with more kernel instructions than this are code-generated at level 0 whatever
   /// optLevel says (compile time ~20x lower, code ~15% slower on the chain; README.md).
   size_t largeModelInstructions = 200000;
+  /// Programs compiled to machine code (programBit); the others run on the kernel interpreter.
+  /// Default: all but parameters and start values, which run once per simulation.
+  uint32_t compiledPrograms = programBit(kernel::ProgramId::Residual) | programBit(kernel::ProgramId::Jacobian) |
+                              programBit(kernel::ProgramId::Outputs) | programBit(kernel::ProgramId::Invariants);
+  /// Compile threads; 0 = one per hardware thread (at most 8).
+  unsigned threads = 0;
 };
 
 /// What compiling cost, and how the programs were split (for tests and measurements).
 struct JitStats {
-  double lowerSeconds = 0;     ///< kernel IR -> LLVM IR
-  double optimiseSeconds = 0;  ///< the optimisation pipeline
-  double codegenSeconds = 0;   ///< machine code generation and linking (ORC lookup)
-  std::array<uint32_t, kernel::kProgramCount> functions{};   ///< LLVM functions per program
+  double lowerSeconds = 0;     ///< kernel IR -> LLVM IR (summed over threads)
+  double optimiseSeconds = 0;  ///< the optimisation pipeline (summed over threads)
+  double codegenSeconds = 0;   ///< machine code generation (summed over threads)
+  double linkSeconds = 0;      ///< creating the JIT, linking the objects, looking up the entries
+  double wallSeconds = 0;      ///< the whole compile, as the user waits for it
+  unsigned threads = 0;        ///< compile threads used
+  unsigned units = 0;          ///< modules compiled (each part of a program is in exactly one)
+  std::array<uint32_t, kernel::kProgramCount> functions{};   ///< LLVM functions per program (0: interpreted)
   std::array<uint32_t, kernel::kProgramCount> spillSlots{};  ///< values passed between them
 };
 

@@ -1,5 +1,5 @@
 // qdot_llvm_bench: compile-time and run-time measurements of the LLVM backend (README.md).
-//   qdot_llvm_bench FILE.qd [n] [optLevel] [maxInstructionsPerFunction] [pipelineLevel]
+//   qdot_llvm_bench FILE.qd [n] [optLevel] [maxInstructionsPerFunction] [pipelineLevel] [threads] [mask] [jacobianOptLevel]
 // Runs the front end (overriding `Integer n = ...` with n if given), then JIT-compiles the kernels
 // and prints the compile phases, and the residual evaluation time of the JIT and the bytecode VM.
 #include <chrono>
@@ -25,16 +25,18 @@ using Clock = std::chrono::steady_clock;
 
 static double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-// Nanoseconds per residual call (repeats until ~0.3 s have passed).
-static double residualNs(const QdotModel* q, const std::vector<double>& p) {
+// Nanoseconds per residual (or Jacobian) call (repeats until ~0.3 s have passed).
+static double residualNs(const QdotModel* q, const std::vector<double>& p, bool jacobian = false) {
   size_t n = q->nVariables;
-  std::vector<double> y(n), yp(n), F(n);
+  std::vector<double> y(n), yp(n), F(std::max<size_t>(n, q->jacobianNonzeros));
   for (size_t i = 0; i < n; ++i) y[i] = 0.01 * (i % 17), yp[i] = 0.02 * (i % 5);
   size_t calls = 0;
   auto start = Clock::now();
   double elapsed = 0;
   do {
-    for (int r = 0; r < 16; ++r, ++calls) q->residual(q, 0.1, y.data(), yp.data(), p.data(), F.data());
+    for (int r = 0; r < 16; ++r, ++calls)
+      if (jacobian) q->jacobian(q, 0.1, y.data(), yp.data(), p.data(), 10.0, F.data());
+      else q->residual(q, 0.1, y.data(), yp.data(), p.data(), F.data());
     elapsed = since(start);
   } while (elapsed < 0.3);
   return elapsed / calls * 1e9;
@@ -42,7 +44,7 @@ static double residualNs(const QdotModel* q, const std::vector<double>& p) {
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::cerr << "usage: qdot_llvm_bench FILE.qd [n] [optLevel] [maxInstructionsPerFunction] [pipelineLevel]\n";
+    std::cerr << "usage: qdot_llvm_bench FILE.qd [n] [optLevel] [maxInstructionsPerFunction] [pipelineLevel] [threads] [compiledPrograms mask] [jacobianOptLevel]\n";
     return 2;
   }
   std::ifstream in(argv[1]);
@@ -54,6 +56,9 @@ int main(int argc, char** argv) {
   if (argc > 3) options.optLevel = std::atoi(argv[3]);
   if (argc > 4) options.maxInstructionsPerFunction = static_cast<uint32_t>(std::atol(argv[4]));
   if (argc > 5) options.pipelineLevel = std::atoi(argv[5]);
+  if (argc > 6) options.threads = static_cast<unsigned>(std::atoi(argv[6]));
+  if (argc > 7) options.compiledPrograms = static_cast<uint32_t>(std::atoi(argv[7]));
+  if (argc > 8) options.jacobianOptLevel = std::atoi(argv[8]);
 
   auto t0 = Clock::now();
   SourceManager sources;
@@ -100,9 +105,11 @@ int main(int argc, char** argv) {
             << " instructions=" << instructions << " residual=" << k.program(kernel::ProgramId::Residual).code.size()
             << " functions=" << functions << " frontend=" << frontEnd << "s jit=" << total
             << "s (lower " << stats.lowerSeconds << " opt " << stats.optimiseSeconds << " codegen "
-            << stats.codegenSeconds << ") vmbuild=" << vmBuild << "s";
+            << stats.codegenSeconds << " link " << stats.linkSeconds << ", " << stats.units << " units on " << stats.threads
+            << " threads) vmbuild=" << vmBuild << "s";
   if (jit->nVariables <= 20000)
-    std::cout << " residual_ns jit=" << residualNs(jit, p) << " vm=" << residualNs(vm, p);
+    std::cout << " residual_ns jit=" << residualNs(jit, p) << " vm=" << residualNs(vm, p)
+              << " jacobian_ns jit=" << residualNs(jit, p, true) << " vm=" << residualNs(vm, p, true);
   std::cout << "\n";
   jit->destroy(jit);
   vm->destroy(vm);
