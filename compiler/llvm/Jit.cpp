@@ -156,8 +156,8 @@ std::vector<CompileUnit> planUnits(const kernel::KernelModule& k, const JitOptio
 class UnitCompiler {
  public:
   UnitCompiler(const kernel::KernelModule& k, const std::array<ProgramPlan, kernel::kProgramCount>& plans,
-               const llvm::orc::JITTargetMachineBuilder& host, int pipelineLevel)
-      : k_(k), plans_(plans), host_(host), pipelineLevel_(pipelineLevel) {}
+               const llvm::orc::JITTargetMachineBuilder& host, const JitOptions& o)
+      : k_(k), plans_(plans), host_(host), pipelineLevel_(o.pipelineLevel), verify_(o.verifyIR) {}
 
   void compile(CompileUnit& u) {
     const ProgramPlan& plan = plans_[static_cast<size_t>(u.program)];
@@ -171,7 +171,7 @@ class UnitCompiler {
     lowerParts(k_.program(u.program), plan.split, u.first, u.last, plan.name, m, false);
     std::string verifyErrors;
     llvm::raw_string_ostream os(verifyErrors);
-    if (llvm::verifyModule(m, &os)) {
+    if (verify_ && llvm::verifyModule(m, &os)) {
       u.error = "internal error: invalid LLVM IR: " + os.str();
       return;
     }
@@ -209,6 +209,7 @@ class UnitCompiler {
   const std::array<ProgramPlan, kernel::kProgramCount>& plans_;
   const llvm::orc::JITTargetMachineBuilder& host_;
   int pipelineLevel_;
+  bool verify_;
   std::map<int, std::unique_ptr<llvm::TargetMachine>> machines_;
 };
 
@@ -252,7 +253,7 @@ std::unique_ptr<JitSession> JitSession::compile(const kernel::KernelModule& k, c
   std::unique_ptr<llvm::orc::LLJIT> jit;
   double createSeconds = 0;
   compileAll(
-      units, threads, [&] { return UnitCompiler(k, plans, *host, options.pipelineLevel); },
+      units, threads, [&] { return UnitCompiler(k, plans, *host, options); },
       [&] {
         auto start = Clock::now();
         auto created = llvm::orc::LLJITBuilder().setJITTargetMachineBuilder(*host).create();

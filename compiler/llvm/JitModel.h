@@ -41,6 +41,9 @@ struct JitOptions {
                               programBit(kernel::ProgramId::Outputs) | programBit(kernel::ProgramId::Invariants);
   /// Compile threads; 0 = one per hardware thread (at most 8).
   unsigned threads = 0;
+  /// Run LLVM's IR verifier on every module (the tests do; it costs ~60% of lowering, and the
+  /// lowering is the same code for every model).
+  bool verifyIR = false;
 };
 
 /// What compiling cost, and how the programs were split (for tests and measurements).

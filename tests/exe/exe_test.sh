@@ -80,6 +80,29 @@ check build-default 0 "$qdot" build "$utube" -o "$work/utube-default"
 "$qdot" run "$utube" --backend llvm --stop 1 >"$work/default-run.csv"
 same csv-default-backend "$work/default-exe.csv" "$work/default-run.csv"
 
+# On a machine with only the runtime libraries: a root file system holding nothing but the
+# executable and the shared libraries ldd lists (all from Debian's runtime packages, none -dev,
+# no LLVM) runs the model and writes the same CSV. Needs chroot (root); skipped otherwise.
+for pkg in $(ldd "$work/utube-default" | grep -o '/[^ ]*\.so[^ ]*' | xargs -r readlink -f | xargs -r dpkg -S 2>/dev/null | cut -d: -f1 | sort -u); do
+  case $pkg in *-dev | *llvm*) bad "runtime-packages: the executable needs $pkg" ;; *) ok ;; esac
+done
+if [ "$(id -u)" -eq 0 ] && command -v chroot >/dev/null; then
+  root=$work/runtime-only-root
+  rm -rf "$root" && mkdir -p "$root/bin"
+  cp "$work/utube-default" "$root/bin/utube"
+  for lib in $(ldd "$root/bin/utube" | grep -o '/[^ ]*'); do mkdir -p "$root$(dirname "$lib")" && cp -L "$lib" "$root$lib"; done
+  if chroot "$root" /bin/utube --stop 1 >"$work/chroot.csv" 2>"$work/chroot.err"; then
+    same csv-runtime-only-root "$work/chroot.csv" "$work/default-run.csv"
+    echo "runtime-only root: $(find "$root" -type f | wc -l) files, $(du -sh "$root" | cut -f1)"
+  elif grep -q "Operation not permitted" "$work/chroot.err"; then
+    echo "skipped: chroot is not permitted here"
+  else
+    bad "runtime-only root: the executable failed"; sed 's/^/    /' "$work/chroot.err"
+  fi
+else
+  echo "skipped: the runtime-only root needs chroot as root"
+fi
+
 # qdot build's own mistakes.
 check build-no-output 2 "$qdot" build "$utube"
 check build-bad-backend 2 "$qdot" build "$utube" -o "$work/x" --backend jvm

@@ -25,6 +25,7 @@ class KernelSource : public SourceDae {
       : SourceDae(name, text) {
     if (!dae) return;
     kernel = kernel::buildKernels(*dae, ctx);
+    options.verifyIR = true;
     std::string error;
     model = llvmbackend::createJitModel(kernel, sources, options, error, &stats);
     EXPECT_NE(model, nullptr) << error;
