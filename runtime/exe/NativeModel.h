@@ -1,14 +1,19 @@
-// A QdotModel running compiled (ahead-of-time LLVM) programs, with names, pattern and the
-// diagnosis of failures taken from a VM model of the same module.
+// A QdotModel running ahead-of-time compiled programs (qdot build --backend llvm), on the ABI glue
+// of ModelAdapter; names and pattern come from the embedded bytecode module, and when native code
+// yields a non-finite value the VM re-runs the call to say which equation failed (lastError).
 #pragma once
+
+#include <span>
+#include <string>
 
 #include "exe/Embedded.h"
 #include "qdot/model_abi.h"
 
 namespace qdot::exe {
 
-/// Wraps `vm` (owned: destroyed with the result): the native programs compute, and when one yields a
-/// non-finite value the VM re-runs the call to say which equation failed (lastError).
-QdotModel* createNativeModel(QdotModel* vm, const qdot_program_fn programs[6], const uint32_t spill[6]);
+/// A model of the serialised module `bytes` whose programs run as `programs` (with `spill` doubles
+/// of scratch each). nullptr with `error` if the bytes are not a valid module.
+QdotModel* createNativeModel(std::span<const uint8_t> bytes, const qdot_program_fn programs[6],
+                             const uint32_t spill[6], std::string& error);
 
 }  // namespace qdot::exe

@@ -55,13 +55,13 @@ std::string parameterHelp(const QdotModel& model) {
 
 int main(int argc, char** argv) {
   std::string error;
-  QdotModel* model =
-      vm::createModelFromBytes(std::span<const uint8_t>(qdot_model_bytes, qdot_model_size), error);
+  std::span<const uint8_t> bytes(qdot_model_bytes, qdot_model_size);
+  QdotModel* model = qdot_native_programs[0] ? exe::createNativeModel(bytes, qdot_native_programs, qdot_native_spill, error)
+                                             : vm::createModelFromBytes(bytes, error);
   if (!model) {
     std::cerr << "error: the embedded model is invalid: " << error << "\n";
     return 4;
   }
-  if (qdot_native_programs[0]) model = exe::createNativeModel(model, qdot_native_programs, qdot_native_spill);
   CLI::App app{fmt::format("{}: a qdot model; simulates it with SUNDIALS IDA and writes the results as CSV",
                            model->name ? model->name : "model")};
   rt::RunOptions options;

@@ -27,6 +27,34 @@ struct ModelCall {
 /// The programs in model-ABI order (kernel::ProgramId and bc::FunctionId number them the same).
 enum class ModelProgram : uint8_t { Parameters, InitialValues, Residual, Jacobian, Outputs, Invariants };
 
+/// How many values a program writes for model `m` (initialValues: y0, yp0 and nominal).
+inline size_t programOutputCount(const QdotModel& m, ModelProgram program) {
+  switch (program) {
+    case ModelProgram::Parameters: return m.nParameters;
+    case ModelProgram::InitialValues: return 3 * size_t{m.nVariables};
+    case ModelProgram::Residual: return m.nVariables;
+    case ModelProgram::Jacobian: return m.jacobianNonzeros;
+    case ModelProgram::Outputs: return m.nOutputs;
+    case ModelProgram::Invariants: return m.nInvariants;
+  }
+  return 0;
+}
+
+/// Calls program `program` of any model through its ABI table (the inverse of ModelAdapter);
+/// `out` has programOutputCount values. Used to re-run a call on another backend.
+inline int callProgram(const QdotModel& m, ModelProgram program, const ModelCall& c, double* out) {
+  size_t n = m.nVariables;
+  switch (program) {
+    case ModelProgram::Parameters: return m.parameters(&m, c.given, c.overridden, out);
+    case ModelProgram::InitialValues: return m.initialValues(&m, c.p, c.t, out, out + n, out + 2 * n);
+    case ModelProgram::Residual: return m.residual(&m, c.t, c.y, c.yp, c.p, out);
+    case ModelProgram::Jacobian: return m.jacobian(&m, c.t, c.y, c.yp, c.p, c.cj, out);
+    case ModelProgram::Outputs: return m.outputs(&m, c.t, c.y, c.yp, c.p, out);
+    case ModelProgram::Invariants: return m.invariants(&m, c.t, c.y, c.yp, c.p, out);
+  }
+  return 1;
+}
+
 /// State every adapted model carries next to its backend data.
 struct AdaptedModel : QdotModel {
   ModelNameTable names;                      ///< what the table's name arrays point into
