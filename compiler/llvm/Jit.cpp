@@ -99,10 +99,16 @@ struct ProgramPlan {
   int level = 0;
 };
 
-/// Consecutive parts [first, last) of one program: one module, one object.
-struct CompileUnit {
+/// Consecutive parts [first, last) of one program.
+struct Segment {
   ProgramId program{};
   uint32_t first = 0, last = 0;
+};
+
+/// Segments compiled at one level into one module and one object.
+struct CompileUnit {
+  int level = 0;
+  std::vector<Segment> segments;
   size_t instructions = 0;
   std::unique_ptr<llvm::MemoryBuffer> object;
   std::string error;
@@ -120,8 +126,9 @@ unsigned threadCount(const JitOptions& o) {
   return o.threads ? o.threads : std::min(hw, 8u);
 }
 
-// Splits each compiled program and groups its parts into units of about `budget` instructions:
-// big enough that per-module overhead stays small, small enough that `threads` threads share the
+// Splits each compiled program and groups parts of the same level into units of about `budget`
+// instructions: big enough that the per-module cost (a pass pipeline, an object to link) stays
+// small (a small model is one unit per level), small enough that `threads` threads share the
 // work evenly (about two units per thread on a large model).
 std::vector<CompileUnit> planUnits(const kernel::KernelModule& k, const JitOptions& o, unsigned threads,
                                    std::array<ProgramPlan, kernel::kProgramCount>& plans) {
@@ -131,6 +138,7 @@ std::vector<CompileUnit> planUnits(const kernel::KernelModule& k, const JitOptio
   bool large = total > o.largeModelInstructions;
   size_t budget = std::max<size_t>(size_t{4} * o.maxInstructionsPerFunction, total / (2 * threads));
   std::vector<CompileUnit> units;
+  std::map<int, size_t> filling;  // level -> index of the unit being filled at that level
   for (size_t i = 0; i < kernel::kProgramCount; ++i) {
     auto id = static_cast<ProgramId>(i);
     if (!(o.compiledPrograms & programBit(id))) continue;
@@ -140,13 +148,16 @@ std::vector<CompileUnit> planUnits(const kernel::KernelModule& k, const JitOptio
     plan.name = entryName(prog, id);
     plan.split = splitProgram(prog, o.maxInstructionsPerFunction);
     plan.level = large ? 0 : levelOf(id, o);
-    for (uint32_t first = 0; first < plan.split.parts;) {
-      CompileUnit u;
-      u.program = id, u.first = first;
-      for (u.last = first; u.last < plan.split.parts && (u.last == first || u.instructions < budget); ++u.last)
-        u.instructions += plan.split.end(u.last, prog.code.size()) - plan.split.begin(u.last);
-      first = u.last;
-      units.push_back(std::move(u));
+    for (uint32_t part = 0; part < plan.split.parts; ++part) {
+      auto it = filling.find(plan.level);
+      if (it == filling.end() || units[it->second].instructions >= budget) {
+        units.push_back(CompileUnit{plan.level});
+        it = filling.insert_or_assign(plan.level, units.size() - 1).first;
+      }
+      CompileUnit& u = units[it->second];
+      if (u.segments.empty() || u.segments.back().program != id) u.segments.push_back({id, part, part});
+      u.segments.back().last = part + 1;
+      u.instructions += plan.split.end(part, prog.code.size()) - plan.split.begin(part);
     }
   }
   return units;
@@ -160,15 +171,18 @@ class UnitCompiler {
       : k_(k), plans_(plans), host_(host), pipelineLevel_(o.pipelineLevel), verify_(o.verifyIR) {}
 
   void compile(CompileUnit& u) {
-    const ProgramPlan& plan = plans_[static_cast<size_t>(u.program)];
-    llvm::TargetMachine* tm = machine(plan.level, u.error);
+    llvm::TargetMachine* tm = machine(u.level, u.error);
     if (!tm) return;
     auto start = Clock::now();
     llvm::LLVMContext ctx;
-    llvm::Module m(plan.name + "." + std::to_string(u.first), ctx);
+    const Segment& head = u.segments.front();
+    llvm::Module m(partName(plans_[static_cast<size_t>(head.program)].name, head.first), ctx);
     m.setDataLayout(tm->createDataLayout());
     m.setTargetTriple(tm->getTargetTriple().str());
-    lowerParts(k_.program(u.program), plan.split, u.first, u.last, plan.name, m, false);
+    for (const Segment& s : u.segments) {
+      const ProgramPlan& plan = plans_[static_cast<size_t>(s.program)];
+      lowerParts(k_.program(s.program), plan.split, s.first, s.last, plan.name, m, false);
+    }
     std::string verifyErrors;
     llvm::raw_string_ostream os(verifyErrors);
     if (verify_ && llvm::verifyModule(m, &os)) {
@@ -177,7 +191,7 @@ class UnitCompiler {
     }
     u.lower = secondsSince(start);
     start = Clock::now();
-    optimise(m, tm, pipelineLevel_ >= 0 ? pipelineLevel_ : plan.level);
+    optimise(m, tm, pipelineLevel_ >= 0 ? pipelineLevel_ : u.level);
     u.optimise = secondsSince(start);
     start = Clock::now();
     llvm::SmallVector<char, 0> buffer;

@@ -61,7 +61,8 @@ class JitExamplesTest : public ::testing::TestWithParam<std::tuple<std::string, 
 TEST_P(JitExamplesTest, AgreesWithTheKernelInterpreter) {
   auto [file, variant] = GetParam();
   llvmbackend::JitOptions options;
-  options.optLevel = variant.optLevel;
+  options.optLevel = options.jacobianOptLevel = options.coldOptLevel = variant.optLevel;
+  options.compiledPrograms = llvmbackend::kAllPrograms;  // all six programs compiled and compared
   options.maxInstructionsPerFunction = variant.maxInstructions;
   options.pipelineLevel = variant.pipelineLevel;
   KernelSource m(file, readFile(file), options);

@@ -66,7 +66,8 @@ void checkEveryOpcode(int optLevel, uint32_t split) {
   kernel::KernelModule k = opcodeModule();
   SourceManager sm;
   llvmbackend::JitOptions options;
-  options.optLevel = optLevel;
+  options.optLevel = options.jacobianOptLevel = options.coldOptLevel = optLevel;
+  options.compiledPrograms = llvmbackend::kAllPrograms;  // the parameters program has ldgiven/ldover
   options.maxInstructionsPerFunction = split;
   std::string error;
   QdotModel* q = llvmbackend::createJitModel(k, sm, options, error);

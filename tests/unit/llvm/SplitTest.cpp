@@ -47,5 +47,37 @@ TEST(JitSplit, BigChainSplitsIntoSeveralFunctionsAndAgrees) {
   for (size_t i = 0; i < J.size(); ++i) ASSERT_TRUE(sameBits(J[i], refJ[i])) << i;
 }
 
+// The default compile plan: residual, Jacobian and outputs compiled in several units on several
+// threads, parameters and start values interpreted; results identical to the interpreter whatever
+// the number of threads.
+TEST(JitUnits, DefaultPlanOnOneOrFourThreadsAgrees) {
+  for (unsigned threads : {1u, 4u}) {
+    llvmbackend::JitOptions options;
+    options.threads = threads;
+    options.maxInstructionsPerFunction = 200;
+    KernelSource m("chain.qd", chain(300), options);
+    ASSERT_TRUE(m.ok());
+    EXPECT_EQ(m.stats.functions[0], 0u) << "parameters are interpreted";
+    EXPECT_EQ(m.stats.functions[1], 0u) << "start values are interpreted";
+    EXPECT_GT(m.stats.functions[2], 1u);
+    EXPECT_GT(m.stats.functions[4], 0u) << "outputs are compiled";
+    EXPECT_EQ(m.stats.threads, threads);
+    EXPECT_GT(m.stats.units, threads);
+    const QdotModel* q = m.model;
+    size_t n = q->nVariables;
+    std::vector<double> p(q->nParameters), y0(n), yp0(n), nominal(n), F(n), ref(n);
+    ASSERT_EQ(q->parameters(q, nullptr, nullptr, p.data()), 0);
+    EXPECT_EQ(p[1], 1000.0);  // k
+    ASSERT_EQ(q->initialValues(q, p.data(), 0.0, y0.data(), yp0.data(), nominal.data()), 0);
+    EXPECT_EQ(y0[299], 0.01 * 300);  // x[300] starts at 0.01*300
+    for (size_t i = 0; i < n; ++i) yp0[i] = 0.001 * double(i);
+    ASSERT_EQ(q->residual(q, 0.5, y0.data(), yp0.data(), p.data(), F.data()), 0);
+    kernel::Inputs in;
+    in.t = 0.5, in.y = y0, in.yp = yp0, in.p = p;
+    kernel::interpret(m.kernel.program(kernel::ProgramId::Residual), in, ref);
+    for (size_t i = 0; i < n; ++i) ASSERT_TRUE(sameBits(F[i], ref[i])) << threads << " threads, F[" << i << "]";
+  }
+}
+
 }  // namespace
 }  // namespace qdot::test
