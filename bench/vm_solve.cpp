@@ -1,8 +1,7 @@
 // vm_solve: `qdot run --backend bytecode|llvm` in one process, for timing the solve. It makes the calls
 // qdot's command line makes (compiler/driver/main.cpp runSimulate, runtime/sim/Run.cpp runModel):
 // compile to the DAE, kernels, bytecode and VM model (--backend bytecode, the default) or the LLVM
-// JIT model (--backend llvm: llvmbackend::createJitModel(kernels, sources, 2, error), exactly as
-// qdot run), then rt::resolveRunOptions, rt::CsvWriter and
+// JIT model (--backend llvm: llvmbackend::createJitModel with the options qdot run uses), then rt::resolveRunOptions, rt::CsvWriter and
 // rt::simulate — but repeats the simulation and reports the solve's wall time at full precision
 // (`qdot run --stats` rounds it to milliseconds) together with IDA's counters. --breakdown adds
 // one more run with the model's residual and Jacobian timed (their function pointers wrapped).
@@ -41,7 +40,7 @@ struct Compiled {
   driver::StageTimes times;                          ///< parse .. dae
 };
 
-Compiled compile(const std::string& file, const std::string& backend) {
+Compiled compile(const std::string& file, const std::string& backend, bool invariants) {
   driver::Compilation c;
   if (!driver::compileFile(c, file, "", driver::Stage::Dae)) {
     c.diags.render(std::cerr, c.sources);
@@ -57,7 +56,9 @@ Compiled compile(const std::string& file, const std::string& backend) {
   QdotModel* model = nullptr;
   if (backend == "llvm") {
 #ifdef QDOT_BENCH_LLVM
-    model = llvmbackend::createJitModel(kernels, c.sources, 2, error);
+    llvmbackend::JitOptions jit;  // as qdot run (driver/main.cpp jitOptionsFor)
+    if (!invariants) jit.compiledPrograms &= ~llvmbackend::programBit(kernel::ProgramId::Invariants);
+    model = llvmbackend::createJitModel(kernels, c.sources, jit, error);
 #else
     throw std::runtime_error("built without the LLVM backend");
 #endif
@@ -160,7 +161,7 @@ int main(int argc, char** argv) {
   rt::addRunOptions(app, options);
   CLI11_PARSE(app, argc, argv);
   try {
-    Compiled c = compile(file, backend);
+    Compiled c = compile(file, backend, options.invariants);
     rt::ResolvedRun run = rt::resolveRunOptions(options, c.experiment, *c.model);
     rt::SimulationResult result;
     std::vector<double> solves;
