@@ -94,7 +94,7 @@ def qdot_command(build, model, case, repeat):
     for _ in range(repeat):
         wall, log = run([f"{build}/qdot", "run", model, "--backend", "bytecode", "--stats"] + case.run_options())
         # "compile [ms]: parse 0.05, check 0.01, ..., kernel 2.7, codegen (bytecode) 0.18"
-        stages = number(r"compile \[ms\]: (.*)", log).split(",")
+        stages = number(r"compile \[ms\]: (.*)", log).split(";")[0].split(",")
         compile_ms = sum(float(stage.split()[-1]) for stage in stages)
         sample = {"wall": wall, "compile": compile_ms / 1e3,
                   "setup": float(number(r"wall time +setup ([0-9.]+) s", log)),
