@@ -10,6 +10,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
+#include <thread>
 
 #include "ast/ASTPrinter.h"
 #include "bytecode/Emitter.h"
@@ -18,6 +20,7 @@
 #include "llvm/JitModel.h"
 #include "llvm/ObjectFile.h"
 #include "sim/Run.h"
+#include "sim/TieredModel.h"
 #include "vm/Vm.h"
 
 namespace {
@@ -31,6 +34,7 @@ struct Options {
   std::string emit;
   bool timings = false;
   std::string backend = "llvm";
+  bool jitWait = false;  // --jit-wait
   rt::RunOptions run;
   std::string exePath;  // qdot build -o
   std::string buildBackend = "llvm";  // qdot build --backend
@@ -77,6 +81,16 @@ llvmbackend::JitOptions jitOptionsFor(const rt::RunOptions& run) {
   return options;
 }
 
+// How the JIT compiled (--stats).
+void printJitStats(const llvmbackend::JitStats& jit) {
+  uint32_t functions = 0;
+  for (uint32_t f : jit.functions) functions += f;
+  std::cerr << "jit: " << functions << " functions in " << jit.units << " modules on " << jit.threads
+            << " threads in " << jit.wallSeconds * 1e3 << " ms; lower " << jit.lowerSeconds * 1e3
+            << " ms, machine code " << jit.codegenSeconds * 1e3 << " ms (summed over threads), link "
+            << jit.linkSeconds * 1e3 << " ms\n";
+}
+
 // --stats: the time of every compile stage, and how the JIT compiled.
 void printCompileStats(const driver::StageTimes& t, double kernel, const std::string& backend, double codegen,
                        const llvmbackend::JitStats* jit) {
@@ -84,16 +98,72 @@ void printCompileStats(const driver::StageTimes& t, double kernel, const std::st
   std::cerr << "compile [ms]: parse " << t.parse * 1e3 << ", check " << t.check * 1e3 << ", flatten "
             << t.flatten * 1e3 << ", derive " << t.derive * 1e3 << ", dae " << t.dae * 1e3 << ", kernel "
             << kernel * 1e3 << ", codegen (" << backend << ") " << codegen * 1e3 << "; total " << total * 1e3 << "\n";
-  if (!jit) return;
-  uint32_t functions = 0;
-  for (uint32_t f : jit->functions) functions += f;
-  std::cerr << "jit: " << functions << " functions in " << jit->units << " modules on " << jit->threads
-            << " threads; lower " << jit->lowerSeconds * 1e3 << " ms, machine code " << jit->codegenSeconds * 1e3
-            << " ms (summed over threads), link " << jit->linkSeconds * 1e3 << " ms\n";
+  if (jit) printJitStats(*jit);
 }
 
 rt::ExperimentDefaults experimentOf(const dae::Dae& d) {
   return {d.experiment.startTime, d.experiment.stopTime, d.experiment.interval, d.experiment.tolerance};
+}
+
+// What the JIT reports; shared with the compile thread when it runs in the background (read it
+// after rt::finishTiering).
+struct JitOutcome {
+  llvmbackend::JitStats stats;
+  std::string error;
+};
+
+// The model a run simulates, and how it was made.
+struct CompiledModel {
+  QdotModel* model = nullptr;
+  std::string what;     // "bytecode", "llvm", "bytecode, then llvm"
+  bool waited = false;  // the JIT compiled before the run
+  std::shared_ptr<JitOutcome> jit = std::make_shared<JitOutcome>();
+  std::string error;    // why there is no model
+};
+
+// --backend llvm (default): the run starts on the VM while the JIT compiles on a background thread
+// (rt::TieredModel), leaving one core to the solver; --jit-wait compiles first. --backend bytecode:
+// the VM only. A JIT that fails leaves the run on the VM, with a warning.
+CompiledModel compileModel(const kernel::KernelModule& kernels, const SourceManager& sources, const Options& o) {
+  CompiledModel out;
+  if (o.backend == "llvm" && o.jitWait) {
+    out.model = llvmbackend::createJitModel(kernels, sources, jitOptionsFor(o.run), out.jit->error, &out.jit->stats);
+    out.what = "llvm";
+    out.waited = true;
+    if (out.model) return out;
+    std::cerr << "qdot: warning: the LLVM JIT failed (" << out.jit->error << "); running on the bytecode VM instead\n";
+  }
+  QdotModel* vmModel = vm::createModel(bytecode::emitBytecode(kernels, sources), out.error);
+  out.what = "bytecode";
+  out.waited = false;
+  if (!vmModel || o.backend != "llvm" || o.jitWait) {
+    out.model = vmModel;
+    return out;
+  }
+  llvmbackend::JitOptions options = jitOptionsFor(o.run);
+  options.threads = std::max(2u, std::thread::hardware_concurrency()) - 1;  // one core keeps solving
+  out.what = "bytecode, then llvm";
+  out.model = rt::createTieredModel(vmModel, [&kernels, &sources, options, jit = out.jit](const std::atomic<bool>& cancel) {
+    llvmbackend::JitOptions withCancel = options;
+    withCancel.cancel = &cancel;
+    return llvmbackend::createJitModel(kernels, sources, withCancel, jit->error, &jit->stats);
+  });
+  return out;
+}
+
+// After a tiered run: when the JIT was ready and how many calls each tier made (--stats), or why
+// it never was.
+void reportTiers(const rt::TierReport& tiers, const JitOutcome& jit, bool stats) {
+  if (!tiers.ready && !jit.error.empty() && jit.error != "cancelled")
+    std::cerr << "qdot: warning: the LLVM JIT failed (" << jit.error << "); the run stayed on the bytecode VM\n";
+  if (!stats) return;
+  if (tiers.ready)
+    std::cerr << "jit: native code ready " << tiers.readySeconds * 1e3 << " ms after the VM started; "
+              << tiers.firstTierCalls << " model calls on the VM, " << tiers.secondTierCalls << " on native code\n";
+  else
+    std::cerr << "jit: the run ended before the native code was ready (all " << tiers.firstTierCalls
+              << " model calls on the VM)\n";
+  if (tiers.ready) printJitStats(jit.stats);
 }
 
 // Compiles (JIT by default, or bytecode for the VM) and simulates. Exit codes: 0, 1 (model errors), 2 (usage),
@@ -110,34 +180,23 @@ int runSimulate(const Options& o) {
     kernel::printKernels(std::cout, kernels, &c.sources);
     return finish(c, true);
   }
+  if (o.emit == "bytecode") {
+    vm::disassemble(std::cout, bytecode::emitBytecode(kernels, c.sources));
+    return finish(c, true);
+  }
   t0 = std::chrono::steady_clock::now();
-  std::string error, backend = o.emit.empty() ? o.backend : "bytecode";
-  QdotModel* model = nullptr;
-  llvmbackend::JitStats jit;
-  if (backend == "llvm") {
-    model = llvmbackend::createJitModel(kernels, c.sources, jitOptionsFor(o.run), error, &jit);
-    if (!model) {
-      std::cerr << "qdot: warning: the LLVM JIT failed (" << error << "); running on the bytecode VM instead\n";
-      backend = "bytecode";
-    }
-  }
-  if (!model) {
-    bc::Module module = bytecode::emitBytecode(kernels, c.sources);
-    if (o.emit == "bytecode") {
-      vm::disassemble(std::cout, module);
-      return finish(c, true);
-    }
-    model = vm::createModel(module, error);
-  }
+  CompiledModel compiled = compileModel(kernels, c.sources, o);
   double codegenSeconds = secondsSince(t0);
-  if (!model) {
-    std::cerr << "qdot: internal error: " << error << "\n";
+  if (!compiled.model) {
+    std::cerr << "qdot: internal error: " << compiled.error << "\n";
     return 4;
   }
   c.diags.render(std::cerr, c.sources, isatty(2));  // warnings, if any
-  if (o.run.stats) printCompileStats(c.times, kernelSeconds, backend, codegenSeconds, backend == "llvm" ? &jit : nullptr);
-  int code = rt::runModel(*model, o.run, experimentOf(*c.dae), std::cout, std::cerr);
-  model->destroy(model);
+  if (o.run.stats)
+    printCompileStats(c.times, kernelSeconds, compiled.what, codegenSeconds, compiled.waited ? &compiled.jit->stats : nullptr);
+  int code = rt::runModel(*compiled.model, o.run, experimentOf(*c.dae), std::cout, std::cerr);
+  if (const rt::TierReport* tiers = rt::finishTiering(compiled.model)) reportTiers(*tiers, *compiled.jit, o.run.stats);
+  compiled.model->destroy(compiled.model);
   return code;
 }
 
@@ -298,6 +357,9 @@ int main(int argc, char** argv) {
   run->add_option("--model", o.model, "the model (default: the last model in the file)");
   run->add_option("--backend", o.backend, "code generator: llvm (native code by the in-process JIT, default) or bytecode (the VM: no compile time)")
       ->check(CLI::IsMember({"bytecode", "llvm"}));
+  run->add_flag("--jit-wait", o.jitWait,
+                "with --backend llvm: compile before the first step instead of starting on the VM while the JIT "
+                "compiles in the background (same results either way)");
   run->add_option("--emit", o.emit, "print a stage's output instead of running: kernel, bytecode")
       ->check(CLI::IsMember({"kernel", "bytecode"}));
   rt::addRunOptions(*run, o.run);

@@ -136,7 +136,9 @@ std::vector<CompileUnit> planUnits(const kernel::KernelModule& k, const JitOptio
   for (size_t i = 0; i < kernel::kProgramCount; ++i)
     if (o.compiledPrograms & programBit(static_cast<ProgramId>(i))) total += k.programs[i].code.size();
   bool large = total > o.largeModelInstructions;
-  size_t budget = std::max<size_t>(size_t{4} * o.maxInstructionsPerFunction, total / (2 * threads));
+  // At most 100 000 instructions (~0.1 s at level 0): a cancelled compile stops within a unit.
+  size_t budget = std::min<size_t>(std::max<size_t>(size_t{4} * o.maxInstructionsPerFunction, total / (2 * threads)),
+                                   std::max<size_t>(100000, o.maxInstructionsPerFunction));
   std::vector<CompileUnit> units;
   std::map<int, size_t> filling;  // level -> index of the unit being filled at that level
   for (size_t i = 0; i < kernel::kProgramCount; ++i) {
@@ -168,9 +170,13 @@ class UnitCompiler {
  public:
   UnitCompiler(const kernel::KernelModule& k, const std::array<ProgramPlan, kernel::kProgramCount>& plans,
                const llvm::orc::JITTargetMachineBuilder& host, const JitOptions& o)
-      : k_(k), plans_(plans), host_(host), pipelineLevel_(o.pipelineLevel), verify_(o.verifyIR) {}
+      : k_(k), plans_(plans), host_(host), pipelineLevel_(o.pipelineLevel), verify_(o.verifyIR), cancel_(o.cancel) {}
 
   void compile(CompileUnit& u) {
+    if (cancel_ && cancel_->load()) {
+      u.error = "cancelled";
+      return;
+    }
     llvm::TargetMachine* tm = machine(u.level, u.error);
     if (!tm) return;
     auto start = Clock::now();
@@ -224,6 +230,7 @@ class UnitCompiler {
   const llvm::orc::JITTargetMachineBuilder& host_;
   int pipelineLevel_;
   bool verify_;
+  const std::atomic<bool>* cancel_;
   std::map<int, std::unique_ptr<llvm::TargetMachine>> machines_;
 };
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <string>
 
@@ -49,6 +50,9 @@ struct JitOptions {
   /// Run LLVM's IR verifier on every module (the tests do; it costs ~60% of lowering, and the
   /// lowering is the same code for every model).
   bool verifyIR = false;
+  /// If set and it becomes true, compiling stops at the next unit and fails ("cancelled"): the run
+  /// that wanted the code is over (rt::TieredModel).
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 /// What compiling cost, and how the programs were split (for tests and measurements).

@@ -113,9 +113,9 @@ inline RunResult runQdot(const std::string& model, const std::vector<std::string
   TempFile csv(".csv"), err(".log");
   std::vector<std::string> argv = {QDOT_BINARY, "run", modelPath(model)};
   argv.insert(argv.end(), args.begin(), args.end());
-  if (const char* backend = std::getenv("QDOT_TEST_BACKEND")) {  // CTest runs the suite on each backend
-    argv.push_back("--backend");
-    argv.push_back(backend);
+  if (const char* extra = std::getenv("QDOT_TEST_RUN_ARGS")) {  // CTest runs the suite on each backend
+    std::istringstream words(extra);
+    for (std::string word; words >> word;) argv.push_back(word);
   }
   argv.push_back("-o");
   argv.push_back(csv.path());

@@ -1,0 +1,112 @@
+// rt::TieredModel on two stand-in models whose residuals differ (1.0 against 2.0), so each call
+// shows which tier answered: the first until the compile thread publishes the second, the second
+// after; destroy cancels a compile that is still running and releases both tiers.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <future>
+#include <string>
+#include <thread>
+
+#include "sim/TieredModel.h"
+
+namespace qdot::rt::test {
+namespace {
+
+struct StandIn : QdotModel {
+  double value = 0;
+  std::string error;
+  std::atomic<int>* destroyed = nullptr;
+};
+
+QdotModel* standIn(double value, std::atomic<int>* destroyed) {
+  auto* m = new StandIn();
+  m->abiVersion = QDOT_MODEL_ABI_VERSION;
+  m->nVariables = 1;
+  m->value = value;
+  m->error = "tier " + std::to_string(static_cast<int>(value));
+  m->destroyed = destroyed;
+  m->residual = [](const QdotModel* s, double, const double*, const double*, const double*, double* F) {
+    F[0] = static_cast<const StandIn*>(s)->value;
+    return 0;
+  };
+  m->lastError = [](const QdotModel* s) { return static_cast<const StandIn*>(s)->error.c_str(); };
+  m->destroy = [](QdotModel* s) {
+    auto* self = static_cast<StandIn*>(s);
+    ++*self->destroyed;
+    delete self;
+  };
+  return m;
+}
+
+double residualOf(const QdotModel* m) {
+  double y = 0, yp = 0, F = -1;
+  EXPECT_EQ(m->residual(m, 0, &y, &yp, nullptr, &F), 0);
+  return F;
+}
+
+TEST(TieredModel, RunsTheFirstTierUntilTheSecondIsReadyThenTheSecond) {
+  std::atomic<int> destroyed{0};
+  std::promise<void> release;
+  std::shared_future<void> released = release.get_future().share();
+  QdotModel* m = createTieredModel(standIn(1.0, &destroyed), [&, released](const std::atomic<bool>&) {
+    released.wait();
+    return standIn(2.0, &destroyed);
+  });
+  EXPECT_EQ(m->nVariables, 1u);  // the first tier's table
+  EXPECT_EQ(residualOf(m), 1.0);
+  EXPECT_EQ(residualOf(m), 1.0);
+  EXPECT_STREQ(m->lastError(m), "tier 1");
+  release.set_value();
+  auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (residualOf(m) != 2.0 && std::chrono::steady_clock::now() < deadline) std::this_thread::yield();
+  EXPECT_EQ(residualOf(m), 2.0);
+  EXPECT_STREQ(m->lastError(m), "tier 2");
+  const TierReport* report = finishTiering(m);
+  ASSERT_NE(report, nullptr);
+  EXPECT_TRUE(report->ready);
+  EXPECT_GE(report->firstTierCalls, 2u);
+  EXPECT_GE(report->secondTierCalls, 2u);
+  m->destroy(m);
+  EXPECT_EQ(destroyed.load(), 2);
+}
+
+TEST(TieredModel, DestroyCancelsACompileStillRunning) {
+  std::atomic<int> destroyed{0};
+  std::atomic<bool> sawCancel{false};
+  QdotModel* m = createTieredModel(standIn(1.0, &destroyed), [&](const std::atomic<bool>& cancel) -> QdotModel* {
+    while (!cancel.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    sawCancel = true;
+    return nullptr;  // gave up
+  });
+  EXPECT_EQ(residualOf(m), 1.0);
+  const TierReport* report = finishTiering(m);
+  ASSERT_NE(report, nullptr);
+  EXPECT_FALSE(report->ready);
+  EXPECT_EQ(report->firstTierCalls, 1u);
+  EXPECT_TRUE(sawCancel.load());
+  m->destroy(m);
+  EXPECT_EQ(destroyed.load(), 1);
+}
+
+TEST(TieredModel, ASecondTierFinishedAfterTheRunIsReleasedUnused) {
+  std::atomic<int> destroyed{0};
+  QdotModel* m = createTieredModel(standIn(1.0, &destroyed), [&](const std::atomic<bool>& cancel) {
+    while (!cancel.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    return standIn(2.0, &destroyed);  // finished anyway
+  });
+  EXPECT_EQ(residualOf(m), 1.0);
+  m->destroy(m);
+  EXPECT_EQ(destroyed.load(), 2);
+}
+
+TEST(TieredModel, FinishTieringIgnoresOtherModels) {
+  std::atomic<int> destroyed{0};
+  QdotModel* plain = standIn(1.0, &destroyed);
+  EXPECT_EQ(finishTiering(plain), nullptr);
+  plain->destroy(plain);
+}
+
+}  // namespace
+}  // namespace qdot::rt::test
