@@ -11,6 +11,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <thread>
 
 #include "ast/ASTPrinter.h"
@@ -115,7 +116,7 @@ struct JitOutcome {
 // The model a run simulates, and how it was made.
 struct CompiledModel {
   QdotModel* model = nullptr;
-  std::string what;     // "bytecode", "llvm", "bytecode, then llvm"
+  std::string what;     // "bytecode", "llvm", "bytecode then llvm"
   bool waited = false;  // the JIT compiled before the run
   std::shared_ptr<JitOutcome> jit = std::make_shared<JitOutcome>();
   std::string error;    // why there is no model
@@ -142,7 +143,7 @@ CompiledModel compileModel(const kernel::KernelModule& kernels, const SourceMana
   }
   llvmbackend::JitOptions options = jitOptionsFor(o.run);
   options.threads = std::max(2u, std::thread::hardware_concurrency()) - 1;  // one core keeps solving
-  out.what = "bytecode, then llvm";
+  out.what = "bytecode then llvm";
   out.model = rt::createTieredModel(vmModel, [&kernels, &sources, options, jit = out.jit](const std::atomic<bool>& cancel) {
     llvmbackend::JitOptions withCancel = options;
     withCancel.cancel = &cancel;
@@ -152,18 +153,19 @@ CompiledModel compileModel(const kernel::KernelModule& kernels, const SourceMana
 }
 
 // After a tiered run: when the JIT was ready and how many calls each tier made (--stats), or why
-// it never was.
+// it never was. The JIT outcome is read only once the compile thread has finished.
 void reportTiers(const rt::TierReport& tiers, const JitOutcome& jit, bool stats) {
-  if (!tiers.ready && !jit.error.empty() && jit.error != "cancelled")
-    std::cerr << "qdot: warning: the LLVM JIT failed (" << jit.error << "); the run stayed on the bytecode VM\n";
+  bool failed = !tiers.compiling && !tiers.ready && !jit.error.empty() && jit.error != "cancelled";
+  if (failed) std::cerr << "qdot: warning: the LLVM JIT failed (" << jit.error << "); the run stayed on the bytecode VM\n";
   if (!stats) return;
-  if (tiers.ready)
+  if (tiers.ready) {
     std::cerr << "jit: native code ready " << tiers.readySeconds * 1e3 << " ms after the VM started; "
               << tiers.firstTierCalls << " model calls on the VM, " << tiers.secondTierCalls << " on native code\n";
-  else
+    printJitStats(jit.stats);
+  } else if (!failed) {
     std::cerr << "jit: the run ended before the native code was ready (all " << tiers.firstTierCalls
               << " model calls on the VM)\n";
-  if (tiers.ready) printJitStats(jit.stats);
+  }
 }
 
 // Compiles (JIT by default, or bytecode for the VM) and simulates. Exit codes: 0, 1 (model errors), 2 (usage),
@@ -195,7 +197,14 @@ int runSimulate(const Options& o) {
   if (o.run.stats)
     printCompileStats(c.times, kernelSeconds, compiled.what, codegenSeconds, compiled.waited ? &compiled.jit->stats : nullptr);
   int code = rt::runModel(*compiled.model, o.run, experimentOf(*c.dae), std::cout, std::cerr);
-  if (const rt::TierReport* tiers = rt::finishTiering(compiled.model)) reportTiers(*tiers, *compiled.jit, o.run.stats);
+  if (std::optional<rt::TierReport> tiers = rt::tierReport(compiled.model)) {
+    reportTiers(*tiers, *compiled.jit, o.run.stats);
+    if (tiers->compiling) {  // its code can no longer be used: exit without waiting for the compiler
+      std::cout.flush();
+      std::cerr.flush();
+      std::_Exit(code);
+    }
+  }
   compiled.model->destroy(compiled.model);
   return code;
 }

@@ -15,13 +15,15 @@ struct Tiered : QdotModel {
   std::atomic<bool> cancel{false};
   std::thread compiler;
   std::chrono::steady_clock::time_point created = std::chrono::steady_clock::now();
+  std::atomic<bool> done{false};     // the compile thread has finished (release)
+  std::atomic<double> readySeconds{0};
   mutable const QdotModel* last = nullptr;  // the tier of the last call (solver thread only)
-  mutable TierReport report;
+  mutable uint64_t firstCalls = 0, secondCalls = 0;
 
   const QdotModel& active() const {
     const QdotModel* m = second.load(std::memory_order_acquire);
-    if (m) ++report.secondTierCalls;
-    else m = first, ++report.firstTierCalls;
+    if (m) ++secondCalls;
+    else m = first, ++firstCalls;
     last = m;
     return *m;
   }
@@ -86,23 +88,29 @@ QdotModel* createTieredModel(QdotModel* first, TierCompiler compile) {
   t->lastError = lastError, t->destroy = destroy;
   t->compiler = std::thread([t, compile = std::move(compile)] {
     QdotModel* second = compile(t->cancel);
-    if (!second) return;
-    if (t->cancel.load()) {  // too late: the run is over
+    if (second && t->cancel.load()) {  // too late: the run is over
       second->destroy(second);
-      return;
+      second = nullptr;
     }
-    t->report.ready = true;
-    t->report.readySeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t->created).count();
-    t->second.store(second, std::memory_order_release);
+    if (second) {
+      t->readySeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t->created).count();
+      t->second.store(second, std::memory_order_release);
+    }
+    t->done.store(true, std::memory_order_release);
   });
   return t;
 }
 
-const TierReport* finishTiering(QdotModel* model) {
-  if (!model || model->destroy != destroy) return nullptr;
-  auto* t = static_cast<Tiered*>(model);
-  t->join();
-  return &t->report;
+std::optional<TierReport> tierReport(const QdotModel* model) {
+  if (!model || model->destroy != destroy) return std::nullopt;
+  const Tiered& t = self(model);
+  TierReport r;
+  r.compiling = !t.done.load(std::memory_order_acquire);
+  r.ready = t.second.load(std::memory_order_acquire) != nullptr;
+  r.readySeconds = r.ready ? t.readySeconds.load() : 0;
+  r.firstTierCalls = t.firstCalls;
+  r.secondTierCalls = t.secondCalls;
+  return r;
 }
 
 }  // namespace qdot::rt

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "qdot/model_abi.h"
@@ -20,20 +21,23 @@ namespace qdot::rt {
 /// returning nullptr, once `cancel` is set (the run ended before it was done).
 using TierCompiler = std::function<QdotModel*(const std::atomic<bool>& cancel)>;
 
-/// What happened to the second tier (read after the run).
+/// What happened to the second tier so far.
 struct TierReport {
-  bool ready = false;          ///< the second tier was compiled
-  double readySeconds = 0;     ///< when, after the tiered model was created (wall)
-  uint64_t firstTierCalls = 0; ///< calls made on the first tier (all calls if never ready)
+  bool compiling = false;       ///< the compile thread is still running
+  bool ready = false;           ///< the second tier was compiled and is in use
+  double readySeconds = 0;      ///< when, after the tiered model was created (wall)
+  uint64_t firstTierCalls = 0;  ///< calls made on the first tier (all calls if never ready)
   uint64_t secondTierCalls = 0;
 };
 
 /// Creates the tiered model; owns `first` and whatever `compile` returns. compile runs on its own
-/// thread at once. destroy() cancels and joins it.
+/// thread at once. destroy() cancels and joins it (a program about to exit need not wait for it:
+/// qdot run ends with _Exit when the compile is still running, tierReport().compiling).
 QdotModel* createTieredModel(QdotModel* first, TierCompiler compile);
 
-/// The report of a model made by createTieredModel; nullptr for any other model. Joins the
-/// compile thread first (cancelling it), so the report is final.
-const TierReport* finishTiering(QdotModel* model);
+/// The report of a model made by createTieredModel, without waiting; nullopt for any other model.
+/// Call it from the thread that calls the model. Once `compiling` is false, whatever the compile
+/// function wrote before returning may be read.
+std::optional<TierReport> tierReport(const QdotModel* model);
 
 }  // namespace qdot::rt

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <future>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -60,12 +61,14 @@ TEST(TieredModel, RunsTheFirstTierUntilTheSecondIsReadyThenTheSecond) {
   EXPECT_STREQ(m->lastError(m), "tier 1");
   release.set_value();
   auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-  while (residualOf(m) != 2.0 && std::chrono::steady_clock::now() < deadline) std::this_thread::yield();
+  while ((residualOf(m) != 2.0 || tierReport(m)->compiling) && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::yield();
   EXPECT_EQ(residualOf(m), 2.0);
   EXPECT_STREQ(m->lastError(m), "tier 2");
-  const TierReport* report = finishTiering(m);
-  ASSERT_NE(report, nullptr);
+  std::optional<TierReport> report = tierReport(m);
+  ASSERT_TRUE(report.has_value());
   EXPECT_TRUE(report->ready);
+  EXPECT_FALSE(report->compiling);
   EXPECT_GE(report->firstTierCalls, 2u);
   EXPECT_GE(report->secondTierCalls, 2u);
   m->destroy(m);
@@ -81,12 +84,13 @@ TEST(TieredModel, DestroyCancelsACompileStillRunning) {
     return nullptr;  // gave up
   });
   EXPECT_EQ(residualOf(m), 1.0);
-  const TierReport* report = finishTiering(m);
-  ASSERT_NE(report, nullptr);
+  std::optional<TierReport> report = tierReport(m);
+  ASSERT_TRUE(report.has_value());
   EXPECT_FALSE(report->ready);
+  EXPECT_TRUE(report->compiling);
   EXPECT_EQ(report->firstTierCalls, 1u);
-  EXPECT_TRUE(sawCancel.load());
   m->destroy(m);
+  EXPECT_TRUE(sawCancel.load());
   EXPECT_EQ(destroyed.load(), 1);
 }
 
@@ -101,10 +105,10 @@ TEST(TieredModel, ASecondTierFinishedAfterTheRunIsReleasedUnused) {
   EXPECT_EQ(destroyed.load(), 2);
 }
 
-TEST(TieredModel, FinishTieringIgnoresOtherModels) {
+TEST(TieredModel, ReportIsOnlyForTieredModels) {
   std::atomic<int> destroyed{0};
   QdotModel* plain = standIn(1.0, &destroyed);
-  EXPECT_EQ(finishTiering(plain), nullptr);
+  EXPECT_FALSE(tierReport(plain).has_value());
   plain->destroy(plain);
 }
 
