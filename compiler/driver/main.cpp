@@ -202,6 +202,7 @@ int runSimulate(const Options& o) {
     if (tiers->compiling) {  // its code can no longer be used: exit without waiting for the compiler
       std::cout.flush();
       std::cerr.flush();
+      std::fflush(nullptr);
       std::_Exit(code);
     }
   }
