@@ -1,7 +1,8 @@
 // Balance check of the DAE via structural matching (see Balance.h).
 #include "dae/Balance.h"
 
-#include <unordered_map>
+#include <algorithm>
+#include <vector>
 
 #include "structural/Matching.h"
 
@@ -27,18 +28,60 @@ std::string joinNames(const Dae& dae, const std::vector<int>& vars, size_t limit
   return s;
 }
 
-structural::BipartiteGraph incidence(const Dae& dae, sym::Context& ctx) {
-  std::unordered_map<const sym::Node*, int> unknownOf;
-  for (int i = 0; i < static_cast<int>(dae.variables.size()); ++i) {
-    const Variable& v = dae.variables[i];
-    unknownOf[v.kind == VarKind::State ? v.yp : v.y] = i;
+// The equation–unknown edges. Unknowns are found by symbol id in a flat array (a hash map over the
+// symbols of a large model missed the cache on nearly every lookup). Residuals are mostly small: they
+// are walked here with a short visited list and reused buffers, since Context::freeSymbols builds a
+// new vector per call (on the spring chain that was half of this stage); a residual with many nodes
+// goes to freeSymbols. A symbol may be reported twice: the graph merges duplicate edges.
+class IncidenceBuilder {
+ public:
+  IncidenceBuilder(const Dae& dae, const sym::Context& ctx) : ctx_(ctx), unknownOf_(ctx.symbolCount(), -1) {
+    for (int i = 0; i < static_cast<int>(dae.variables.size()); ++i) {
+      const Variable& v = dae.variables[i];
+      unknownOf_[(v.kind == VarKind::State ? v.yp : v.y)->symbolId] = i;
+    }
   }
-  std::vector<structural::Edge> edges;
-  for (int e = 0; e < static_cast<int>(dae.equations.size()); ++e)
-    for (sym::Expr s : ctx.freeSymbols(dae.equations[e].residual))
-      if (auto it = unknownOf.find(s); it != unknownOf.end()) edges.push_back({e, it->second});
+
+  void addEquation(int equation, sym::Expr residual) {
+    stack_.assign(1, residual);
+    visited_.clear();
+    while (!stack_.empty()) {
+      sym::Expr n = stack_.back();
+      stack_.pop_back();
+      if (n->isSymbol()) {
+        addSymbol(equation, n);
+      } else if (n->symbolMask && std::find(visited_.begin(), visited_.end(), n) == visited_.end()) {
+        if (visited_.size() == kSmall) return addAllSymbols(equation, residual);
+        visited_.push_back(n);
+        stack_.insert(stack_.end(), n->args.begin(), n->args.end());
+        stack_.insert(stack_.end(), n->exps.begin(), n->exps.end());
+      }
+    }
+  }
+
+  std::vector<structural::Edge>& edges() { return edges_; }
+
+ private:
+  static constexpr size_t kSmall = 32;  ///< operation nodes walked here; a linear visited list stays cheap
+
+  void addSymbol(int equation, sym::Expr s) {
+    if (int unknown = unknownOf_[s->symbolId]; unknown >= 0) edges_.push_back({equation, unknown});
+  }
+  void addAllSymbols(int equation, sym::Expr residual) {
+    for (sym::Expr s : ctx_.freeSymbols(residual)) addSymbol(equation, s);
+  }
+
+  const sym::Context& ctx_;
+  std::vector<int> unknownOf_;  ///< by symbolId: the unknown it stands for, or -1
+  std::vector<structural::Edge> edges_;
+  std::vector<sym::Expr> stack_, visited_;
+};
+
+structural::BipartiteGraph incidence(const Dae& dae, const sym::Context& ctx) {
+  IncidenceBuilder builder(dae, ctx);
+  for (int e = 0; e < static_cast<int>(dae.equations.size()); ++e) builder.addEquation(e, dae.equations[e].residual);
   return structural::BipartiteGraph(static_cast<int>(dae.equations.size()), static_cast<int>(dae.variables.size()),
-                                    edges);
+                                    builder.edges());
 }
 
 }  // namespace

@@ -18,10 +18,11 @@ class Builder {
     dae_.name = m_.name;
     dae_.description = m_.description;
     dae_.range = m_.range;
-    dae_.time = m_.variables[m_.byName.at("time")].symbol;
+    dae_.time = m_.time();
     dae_.experiment = m_.experiment;
     dae_.outputs = m_.outputs;
     addParameters();
+    dae_.variables.reserve(unknownCount());
     addMechanics();
     addUnknowns();
     addEquations();
@@ -46,17 +47,34 @@ class Builder {
   Dae dae_;
   std::vector<Equation> kinematic_;
 
+  // At most: a coordinate and its velocity per row, every other unknown, every multiplier.
+  size_t unknownCount() const {
+    size_t n = 2 * eom_.rows.size() + eom_.multipliers.size();
+    for (const auto& f : m_.variables) n += f.role == flat::VarRole::Unknown;
+    return n;
+  }
+
   Variable fromFlat(int index, VarKind kind, VarRole role) {
     const flat::Variable& f = m_.variables[index];
-    Variable v{.name = f.name, .kind = kind, .role = role, .y = f.symbol, .flatVar = index, .declRange = f.declRange,
-               .start = f.start, .fixed = f.fixed, .nominal = f.nominal, .description = f.description, .unit = f.unit};
+    Variable v{.name = std::string(f.name),
+               .kind = kind,
+               .role = role,
+               .y = f.symbol,
+               .flatVar = index,
+               .declRange = f.declRange,
+               .start = f.start,
+               .fixed = f.fixed,
+               .nominal = f.nominal,
+               .description = std::string(f.description),
+               .unit = std::string(f.unit)};
     return v;
   }
 
   void addParameters() {
     for (const auto& f : m_.variables)
       if (f.role == flat::VarRole::Parameter)
-        dae_.parameters.push_back({f.name, f.symbol, f.value, f.description, f.unit, f.declRange});
+        dae_.parameters.push_back(
+            {std::string(f.name), f.symbol, f.value, std::string(f.description), std::string(f.unit), f.declRange});
   }
 
   // Coordinates first, then velocities (spec §5). A coordinate whose row contains no velocity at
@@ -64,25 +82,26 @@ class Builder {
   // as a state and its velocity algebraic.
   void addMechanics() {
     std::vector<Variable> velocities;
+    velocities.reserve(eom_.rows.size());
     for (const auto& row : eom_.rows) {
       const flat::Variable& q = m_.variables[row.coordinate];
       const flat::Variable& v = m_.variables[q.derivative];
-      bool rowHasVelocity = ctx_.dependsOn(row.residual, v.symbol);
       dae_.coordinates.push_back(static_cast<int>(dae_.variables.size()));
-      if (!row.inertial && !rowHasVelocity) {
+      if (!row.inertial && !ctx_.dependsOn(row.residual, v.symbol)) {
         dae_.variables.push_back(fromFlat(row.coordinate, VarKind::Algebraic, VarRole::Coordinate));
         continue;
       }
       Variable qv = fromFlat(row.coordinate, VarKind::State, VarRole::Coordinate);
-      qv.yp = ctx_.symbol("$der(" + q.name + ")");
+      qv.yp = ctx_.symbol("$der(" + std::string(q.name) + ")");
       kinematic_.push_back({ctx_.sub(qv.yp, v.symbol), {flat::OriginKind::Kinematic, q.declRange, row.coordinate, ""}});
-      dae_.variables.push_back(qv);
+      dae_.variables.push_back(std::move(qv));
       Variable vv = fromFlat(q.derivative, row.inertial ? VarKind::State : VarKind::Algebraic, VarRole::Velocity);
       vv.start = v.start ? v.start : ctx_.zero();  // a velocity starts at 0 unless an initial equation says otherwise
       if (row.inertial) vv.yp = m_.variables[v.derivative].symbol;
-      velocities.push_back(vv);
+      velocities.push_back(std::move(vv));
     }
-    dae_.variables.insert(dae_.variables.end(), velocities.begin(), velocities.end());
+    dae_.variables.insert(dae_.variables.end(), std::make_move_iterator(velocities.begin()),
+                          std::make_move_iterator(velocities.end()));
   }
 
   void addUnknowns() {
@@ -93,12 +112,13 @@ class Builder {
       if (f.derivative >= 0) {
         Variable v = fromFlat(i, VarKind::State, VarRole::State);
         v.yp = m_.variables[f.derivative].symbol;
-        dae_.variables.push_back(v);
+        dae_.variables.push_back(std::move(v));
       } else {
         algebraic.push_back(fromFlat(i, VarKind::Algebraic, VarRole::Algebraic));
       }
     }
-    dae_.variables.insert(dae_.variables.end(), algebraic.begin(), algebraic.end());
+    dae_.variables.insert(dae_.variables.end(), std::make_move_iterator(algebraic.begin()),
+                          std::make_move_iterator(algebraic.end()));
     for (const auto& mult : eom_.multipliers) {
       const auto& c = m_.constraints[mult.constraint];
       dae_.variables.push_back({.name = mult.name, .kind = VarKind::Algebraic, .role = VarRole::Multiplier,
@@ -108,11 +128,13 @@ class Builder {
   }
 
   void addEquations() {
+    dae_.equations.reserve(eom_.rows.size() + kinematic_.size() + m_.equations.size() + m_.constraints.size());
     for (const auto& row : eom_.rows) {
       const flat::Variable& q = m_.variables[row.coordinate];
       dae_.equations.push_back({row.residual, {flat::OriginKind::EulerLagrange, q.declRange, row.coordinate, ""}});
     }
-    dae_.equations.insert(dae_.equations.end(), kinematic_.begin(), kinematic_.end());
+    dae_.equations.insert(dae_.equations.end(), std::make_move_iterator(kinematic_.begin()),
+                          std::make_move_iterator(kinematic_.end()));
     for (const auto& e : m_.equations) dae_.equations.push_back({e.residual, e.origin, e.lhs, e.rhs});
     for (size_t k = 0; k < m_.constraints.size(); ++k) {
       const auto& c = m_.constraints[k];

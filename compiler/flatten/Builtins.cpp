@@ -28,20 +28,28 @@ const UnaryMath kUnaryMath[] = {
 // d/dt with one memo for the whole model. A symbol's rate is asked once, when a derivative first
 // reaches it: time → 1, parameters (and non-variables) → 0, any other variable → its der() variable,
 // created on demand (an error at `where` if it cannot have one; it is then asked again next time).
-// The rate function is re-bound on each call so that error carries this call's location.
 Expr Flattener::timeDerivative(Expr e, SourceRange where) {
-  timeDerivative_.setRateFunction([this, where](Expr s) {
-    int var = out_.variableOf(s);
-    if (var < 0 || out_.variables[var].role == VarRole::Parameter) return ctx_.zero();
-    if (out_.variables[var].role == VarRole::Time) return ctx_.one();
-    return out_.variables[derivativeVariable(var, where)].symbol;
-  });
+  derivativeSite_ = where;
   return timeDerivative_(e);
+}
+
+// The rate function of timeDerivative_, bound once (binding a new closure per der() call cost a heap
+// block each); the current call's location comes from derivativeSite_.
+Expr Flattener::rateOf(Expr s) {
+  int var = out_.variableOf(s);
+  if (var < 0 || out_.variables[var].role == VarRole::Parameter) return ctx_.zero();
+  if (out_.variables[var].role == VarRole::Time) return ctx_.one();
+  return out_.variables[derivativeVariable(var, derivativeSite_)].symbol;
 }
 
 Value Flattener::lowerCall(const CallExpr& e) {
   std::string name = e.callee->dotted();
   auto arg = [&](size_t i) { return lower(*e.args.at(i)); };
+  if (name == "der") {  // first: the call met most often (in the energies, once per element)
+    Value v = arg(0);
+    for (Expr& x : v.elems) x = timeDerivative(x, e.range);
+    return v;
+  }
   for (const auto& u : kUnaryMath)
     if (name == u.name) return mapUnary(arg(0), u.kind);
   if (name == "sqrt" || name == "log10") {
@@ -49,11 +57,6 @@ Value Flattener::lowerCall(const CallExpr& e) {
     for (Expr& x : v.elems)
       x = name == "sqrt" ? ctx_.pow(x, ctx_.constant(0.5))
                          : ctx_.div(ctx_.unary(Kind::Log, x), ctx_.constant(std::log(10.0)));
-    return v;
-  }
-  if (name == "der") {
-    Value v = arg(0);
-    for (Expr& x : v.elems) x = timeDerivative(x, e.range);
     return v;
   }
   if (name == "sum" || name == "product") return lowerReduction(e, name == "sum");
@@ -86,7 +89,7 @@ Value Flattener::lowerReduction(const CallExpr& e, bool isSum) {
     for (Expr x : v.elems) parts.push_back(Value::scalar(x));
   }
   if (parts.empty()) return Value::scalar(isSum ? ctx_.zero() : ctx_.one());
-  Value r{parts[0].shape, std::vector<Expr>(parts[0].size())};
+  Value r{parts[0].shape, ExprList(parts[0].size(), nullptr)};
   std::vector<Expr> column(parts.size());
   for (size_t k = 0; k < r.size(); ++k) {
     for (size_t i = 0; i < parts.size(); ++i) {
@@ -114,7 +117,7 @@ Value Flattener::lowerArrayBuiltin(const std::string& name, const CallExpr& e) {
     size_t n = 1;
     for (int d : dims) n *= static_cast<size_t>(d);
     countScalars(n, e.range);
-    return Value{std::move(dims), std::vector<Expr>(n, v)};
+    return Value{std::move(dims), ExprList(n, v)};
   };
   if (name == "fill") return filled(dimsFrom(1), lowerScalar(*e.args[0], "the value of fill()"));
   if (name == "zeros") return filled(dimsFrom(0), ctx_.zero());
@@ -136,7 +139,7 @@ Value Flattener::lowerArrayBuiltin(const std::string& name, const CallExpr& e) {
   if (name == "transpose") {
     Value m = arg(0);
     if (m.shape.size() != 2) fail(e.args[0]->range, "E0307", "transpose() takes a matrix, got " + shapeText(m.shape));
-    Value t{{m.shape[1], m.shape[0]}, std::vector<Expr>(m.size())};
+    Value t{{m.shape[1], m.shape[0]}, ExprList(m.size(), nullptr)};
     for (int i = 0; i < m.shape[0]; ++i)
       for (int j = 0; j < m.shape[1]; ++j) t.elems[j * m.shape[0] + i] = m.elems[i * m.shape[1] + j];
     return t;

@@ -1,6 +1,7 @@
 // Lowers AST expressions to Values (arrays of symbolic expressions): names, subscripts, operators
 // with Modelica's array rules, built-in functions, reductions, comprehensions, der().
 // Error codes E03xx (see compiler/flatten/README.md).
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -61,7 +62,7 @@ Value Flattener::lower(const ast::Expr& e) {
     case ExprKind::If: return lowerIf(*cast<IfExpr>(&e));
     case ExprKind::End:
       if (endContext_.empty()) fail(e.range, "E0304", "'end' is only allowed inside a subscript");
-      return Value::scalar(ctx_.constant(endContext_.back()->shape[endDim_.back()]));
+      return Value::scalar(ctx_.constant(endContext_.back().first->shape[endContext_.back().second]));
     case ExprKind::String: fail(e.range, "E0213", "a string is not allowed here");
     case ExprKind::Member: fail(e.range, "E0290", "component member access is not supported yet");
   }
@@ -74,28 +75,48 @@ Value Flattener::lowerName(const NameExpr& n) {
     if (it->first == name) return Value::scalar(it->second);
   auto s = m_.symbols.find(name);
   if (s != m_.symbols.end()) return valueOf(*s->second.decl, n.range);
-  if (name == "time") return Value::scalar(out_.variables[out_.byName.at("time")].symbol);
+  if (name == "time") return Value::scalar(out_.time());
   if (name == "pi") return Value::scalar(ctx_.constant(std::numbers::pi));
   fail(n.range, "E0202", "unknown name '" + name + "'");
 }
 
+// `end` inside subscript `dim` of `base` means the size of that dimension while this lives.
+class Flattener::EndScope {
+ public:
+  EndScope(Flattener& f, const Value& base, size_t dim) : f_(f) {
+    f_.endContext_.push_back({&base, static_cast<int>(dim)});
+  }
+  ~EndScope() { f_.endContext_.pop_back(); }
+  EndScope(const EndScope&) = delete;
+  EndScope& operator=(const EndScope&) = delete;
+
+ private:
+  Flattener& f_;
+};
+
+void Flattener::checkIndex(int i, int dimSize, const ast::Expr& s) {
+  if (i < 1 || i > dimSize)
+    fail(s.range, "E0301", "index " + std::to_string(i) + " is out of range 1:" + std::to_string(dimSize),
+         "array indices start at 1 and end at the size of the dimension");
+}
+
+// A subscript that is a single index (not a range).
+int Flattener::subscriptIndex(const ast::Expr& s, int dimSize) {
+  int i = static_cast<int>(lowerInteger(s, "a subscript"));
+  checkIndex(i, dimSize, s);
+  return i;
+}
+
 std::vector<int> Flattener::subscriptIndices(const ast::Expr& s, int dimSize) {
-  std::vector<int> idx;
   auto* r = dyn_cast<RangeExpr>(&s);
-  if (r && !r->start && !r->stop) {  // `:`
+  if (!r) return {subscriptIndex(s, dimSize)};
+  std::vector<int> idx;
+  if (!r->start && !r->stop) {  // `:`
     for (int i = 1; i <= dimSize; ++i) idx.push_back(i);
     return idx;
   }
-  if (r) {
-    for (Expr v : iterationValues(s)) idx.push_back(static_cast<int>(v->value));
-  } else {
-    idx.push_back(static_cast<int>(lowerInteger(s, "a subscript")));
-  }
-  for (int i : idx)
-    if (i < 1 || i > dimSize)
-      fail(s.range, "E0301",
-           "index " + std::to_string(i) + " is out of range 1:" + std::to_string(dimSize),
-           "array indices start at 1 and end at the size of the dimension");
+  for (Expr v : iterationValues(s)) idx.push_back(static_cast<int>(v->value));
+  for (int i : idx) checkIndex(i, dimSize, s);
   return idx;
 }
 
@@ -119,22 +140,16 @@ Value Flattener::lowerIndex(const IndexExpr& e) {
     fail(e.range, "E0305",
          std::to_string(e.subscripts.size()) + " subscript(s) given for an array of shape " + shapeText(base.shape),
          base.shape.empty() ? "this is a scalar: remove the subscript" : "give one subscript per dimension");
+  auto isRange = [](const ExprPtr& s) { return dyn_cast<RangeExpr>(s.get()) != nullptr; };
+  if (std::none_of(e.subscripts.begin(), e.subscripts.end(), isRange))
+    return Value::scalar(base.elems[elementOffset(e, base)]);
   std::vector<std::vector<int>> picks;
   Value result;
-  endContext_.push_back(&base);
   for (size_t d = 0; d < e.subscripts.size(); ++d) {
-    endDim_.push_back(static_cast<int>(d));
-    try {
-      picks.push_back(subscriptIndices(*e.subscripts[d], base.shape[d]));
-    } catch (FlattenAbort&) {
-      endDim_.pop_back();
-      endContext_.pop_back();
-      throw;
-    }
-    endDim_.pop_back();
-    if (dyn_cast<RangeExpr>(e.subscripts[d].get())) result.shape.push_back(static_cast<int>(picks.back().size()));
+    EndScope end(*this, base, d);
+    picks.push_back(subscriptIndices(*e.subscripts[d], base.shape[d]));
+    if (isRange(e.subscripts[d])) result.shape.push_back(static_cast<int>(picks.back().size()));
   }
-  endContext_.pop_back();
   // Enumerate the cartesian product of picks in row-major order.
   std::vector<size_t> pos(picks.size(), 0);
   while (true) {
@@ -146,6 +161,17 @@ Value Flattener::lowerIndex(const IndexExpr& e) {
     if (d == 0) break;
   }
   return result;
+}
+
+// The row-major offset of x[i, j, ...] when every subscript is a single index, the common case in
+// loops: computed directly, without the index lists of the general case.
+size_t Flattener::elementOffset(const IndexExpr& e, const Value& base) {
+  size_t flat = 0;
+  for (size_t d = 0; d < e.subscripts.size(); ++d) {
+    EndScope end(*this, base, d);
+    flat = flat * base.shape[d] + (subscriptIndex(*e.subscripts[d], base.shape[d]) - 1);
+  }
+  return flat;
 }
 
 Value Flattener::mapUnary(const Value& v, Kind k) {
@@ -246,7 +272,7 @@ Value Flattener::lowerProduct(Value a, Value b, const BinaryExpr& e) {
 
 Value Flattener::lowerRange(const RangeExpr& e) {
   Value v;
-  v.elems = iterationValues(e);
+  v.elems = ExprList(iterationValues(e));
   v.shape = {static_cast<int>(v.elems.size())};
   return v;
 }
@@ -256,7 +282,7 @@ std::vector<Expr> Flattener::iterationValues(const ast::Expr& range) {
   if (!r) {
     Value v = lower(range);
     if (v.shape.size() != 1) fail(range.range, "E0308", "a loop range must be a vector, e.g. 1:n");
-    return v.elems;
+    return {v.elems.begin(), v.elems.end()};
   }
   if (!r->start || !r->stop) fail(range.range, "E0308", "a loop range needs a start and a stop, e.g. 1:n");
   double a = lowerConstant(*r->start, "a range bound");
@@ -280,7 +306,7 @@ Value Flattener::stack(std::vector<Value> parts, SourceRange r) {
       fail(r, "E0307", "array elements have different shapes: " + shapeText(parts[0].shape) + " and " +
                            shapeText(parts[i].shape));
   v.shape.insert(v.shape.end(), parts[0].shape.begin(), parts[0].shape.end());
-  for (auto& p : parts) v.elems.insert(v.elems.end(), p.elems.begin(), p.elems.end());
+  for (auto& p : parts) v.elems.append(p.elems);
   return v;
 }
 

@@ -2,11 +2,14 @@
 // expanded to scalar variables (`x[1]`, `M[1,2]`), definitions substituted, constants and Integer
 // parameters folded, every expression a symbolic DAG over the variables' symbols. Every equation
 // and energy term remembers the source range it came from. Handed to the mechanics stage.
+// Variable names are views of their symbols' names (owned by the Context), descriptions and units
+// views of the AST: both outlive the FlatModel, and a large model has one variable per element.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
-#include <unordered_map>
+#include <string_view>
 #include <vector>
 
 #include "support/SourceManager.h"
@@ -14,7 +17,7 @@
 
 namespace qdot::flat {
 
-enum class VarRole {
+enum class VarRole : uint8_t {
   Time,          ///< the independent variable `time`
   Parameter,     ///< run-time parameter (Real or Boolean); `value` is its default
   Coordinate,    ///< generalized coordinate q
@@ -27,14 +30,14 @@ enum class VarRole {
 const char* roleName(VarRole r);
 
 struct Variable {
-  std::string name;  ///< user-facing scalar name: `th[1]`, `der(th[1])`
+  std::string_view name;  ///< user-facing scalar name: `th[1]`, `der(th[1])` (the symbol's name)
   VarRole role = VarRole::Unknown;
+  bool fixed = false;
   sym::Expr symbol = nullptr;
   SourceRange declRange;  ///< the declaration's name (or the der() that created it)
-  std::string description;
-  std::string unit;
+  std::string_view description;
+  std::string_view unit;
   sym::Expr start = nullptr;  ///< start attribute (over parameters); null if none
-  bool fixed = false;
   sym::Expr nominal = nullptr, min = nullptr, max = nullptr;
   sym::Expr value = nullptr;  ///< Parameter: default value (over other parameters)
   int derivative = -1;        ///< index of the variable that is der(this), -1 if none
@@ -84,8 +87,7 @@ struct FlatModel {
   std::string name;
   std::string description;
   SourceRange range;
-  std::vector<Variable> variables;
-  std::unordered_map<std::string, int> byName;
+  std::vector<Variable> variables;    ///< variables[kTime] is `time`
   std::vector<int> symbolToVariable;  ///< indexed by sym symbolId; -1 for non-variable symbols
   std::vector<Equation> equations;
   std::vector<Equation> initialEquations;
@@ -95,7 +97,11 @@ struct FlatModel {
   std::vector<Output> outputs;
   Experiment experiment;
 
-  /// The variable a symbol stands for, or -1.
+  static constexpr int kTime = 0;  ///< index of `time` in variables (a keyword: no other variable has its name)
+  sym::Expr time() const { return variables[kTime].symbol; }
+
+  /// The variable a symbol stands for, or -1 (a variable's symbol has the variable's name, so
+  /// ctx.findSymbol(name) and this find a variable by name).
   int variableOf(sym::Expr s) const {
     return s->isSymbol() && s->symbolId < symbolToVariable.size() ? symbolToVariable[s->symbolId] : -1;
   }

@@ -2,6 +2,7 @@
 // equations and mechanics statements expanded over for-loops, the experiment annotation read.
 #include "flatten/Flatten.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "flatten/Flattener.h"
@@ -52,7 +53,9 @@ std::optional<FlatModel> flatten(const sema::CheckedModel& model, sym::Context& 
 }
 
 Flattener::Flattener(const sema::CheckedModel& m, sym::Context& ctx, DiagnosticEngine& diags, FlattenLimits limits)
-    : m_(m), ctx_(ctx), diags_(diags), limits_(limits) {}
+    : m_(m), ctx_(ctx), diags_(diags), limits_(limits) {
+  timeDerivative_.setRateFunction([this](Expr s) { return rateOf(s); });
+}
 
 template <class F> void Flattener::guarded(F&& body) {
   try {
@@ -80,7 +83,7 @@ std::optional<FlatModel> Flattener::run() {
   out_.name = m_.cls->name;
   out_.description = m_.cls->description;
   out_.range = m_.cls->nameRange;
-  addVariable({.name = "time", .role = VarRole::Time, .symbol = ctx_.symbol("time")});
+  addVariable({.role = VarRole::Time, .symbol = ctx_.symbol("time")});
   for (const auto* d : m_.declarations) guarded([&] { valueOf(*d, d->nameRange); });
   for (const auto& eq : m_.cls->equations) guarded([&] { lowerEquation(eq, out_.equations, OriginKind::Equation); });
   for (const auto& eq : m_.cls->initialEquations)
@@ -98,12 +101,13 @@ void Flattener::countScalars(size_t n, SourceRange r) {
          "reduce the array sizes or loop ranges");
 }
 
+// The variable's name is its symbol's.
 int Flattener::addVariable(Variable v) {
   int index = static_cast<int>(out_.variables.size());
+  v.name = ctx_.symbolName(v.symbol);
   uint32_t id = v.symbol->symbolId;
   if (out_.symbolToVariable.size() <= id) out_.symbolToVariable.resize(id + 1, -1);
   out_.symbolToVariable[id] = index;
-  out_.byName[v.name] = index;
   out_.variables.push_back(std::move(v));
   return index;
 }
@@ -118,10 +122,11 @@ int Flattener::derivativeVariable(int var, SourceRange where) {
                     : role == VarRole::Unknown  ? VarRole::Derivative
                                                 : VarRole::Time;
   if (derRole == VarRole::Time)
-    fail(where, "E0311", "cannot take the derivative of '" + out_.variables[var].name + "' (a " + roleName(role) + ")",
+    fail(where, "E0311",
+         "cannot take the derivative of '" + std::string(out_.variables[var].name) + "' (a " + roleName(role) + ")",
          "higher derivatives are only available for coordinates: declare the variable as 'coordinate Real'");
-  std::string name = "der(" + out_.variables[var].name + ")";
-  Variable d{.name = name, .role = derRole, .symbol = ctx_.symbol(name), .declRange = out_.variables[var].declRange};
+  Expr symbol = ctx_.symbol("der(" + std::string(out_.variables[var].name) + ")");
+  Variable d{.role = derRole, .symbol = symbol, .declRange = out_.variables[var].declRange};
   d.derivativeOf = var;
   int index = addVariable(std::move(d));
   out_.variables[var].derivative = index;
@@ -203,12 +208,22 @@ Value Flattener::createDeclaration(const Declaration& d, const sema::ModelSymbol
   fail(d.range, "E0399", "unsupported declaration");
 }
 
+// Room for `count` more variables, growing geometrically (reserving exactly per declaration would
+// copy the whole vector for every declaration); a large array then fills it without regrowing.
+void Flattener::reserveVariables(size_t count) {
+  std::vector<Variable>& vars = out_.variables;
+  if (vars.size() + count > vars.capacity()) vars.reserve(std::max(vars.size() + count, 2 * vars.capacity()));
+}
+
 Value Flattener::variablesFor(const Declaration& d, const std::vector<int>& shape, VarRole role) {
   Value v{shape, {}};
-  for (std::string& name : scalarNames(d.name, shape)) {
+  std::vector<std::string> names = scalarNames(d.name, shape);
+  // a coordinate brings its velocity and acceleration
+  reserveVariables(role == VarRole::Coordinate ? 3 * names.size() : names.size());
+  v.elems.reserve(names.size());
+  for (const std::string& name : names) {
     Expr symbol = ctx_.symbol(name);
-    addVariable({.name = std::move(name), .role = role, .symbol = symbol, .declRange = d.nameRange,
-                 .description = d.description});
+    addVariable({.role = role, .symbol = symbol, .declRange = d.nameRange, .description = d.description});
     v.elems.push_back(symbol);
   }
   return v;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <initializer_list>
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
@@ -13,10 +14,65 @@
 
 namespace qdot::flat {
 
+/// The elements of a Value. Expanding a loop lowers its body once per iteration, and almost every
+/// value met there is a scalar: keeping a single element inline spares a heap block per scalar
+/// (those blocks were most of flattening's allocations). More elements live in a std::vector.
+class ExprList {
+ public:
+  ExprList() = default;
+  ExprList(std::initializer_list<sym::Expr> init) {
+    for (sym::Expr e : init) push_back(e);
+  }
+  ExprList(size_t n, sym::Expr fill) : size_(n) {
+    if (n == 1) one_ = fill;
+    if (n > 1) many_.assign(n, fill);
+  }
+  explicit ExprList(std::vector<sym::Expr> v) : size_(v.size()) {
+    if (size_ == 1) one_ = v[0];
+    if (size_ > 1) many_ = std::move(v);
+  }
+  ExprList(const ExprList&) = default;
+  ExprList& operator=(const ExprList&) = default;
+  ExprList(ExprList&& o) noexcept : many_(std::move(o.many_)), one_(o.one_), size_(std::exchange(o.size_, 0)) {}
+  ExprList& operator=(ExprList&& o) noexcept {
+    many_ = std::move(o.many_);
+    one_ = o.one_;
+    size_ = std::exchange(o.size_, 0);
+    return *this;
+  }
+
+  size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  sym::Expr* begin() { return size_ > 1 ? many_.data() : &one_; }
+  sym::Expr* end() { return begin() + size_; }
+  const sym::Expr* begin() const { return size_ > 1 ? many_.data() : &one_; }
+  const sym::Expr* end() const { return begin() + size_; }
+  sym::Expr& operator[](size_t i) { return begin()[i]; }
+  sym::Expr operator[](size_t i) const { return begin()[i]; }
+
+  void reserve(size_t n) {
+    if (n > 1) many_.reserve(n);
+  }
+  void push_back(sym::Expr e) {
+    if (size_ == 0) one_ = e;
+    if (size_ == 1) many_.assign({one_, e});  // the inline element moves to the heap
+    if (size_ > 1) many_.push_back(e);
+    ++size_;
+  }
+  void append(const ExprList& more) {
+    for (sym::Expr e : more) push_back(e);  // geometric growth: stack() appends one part at a time
+  }
+
+ private:
+  std::vector<sym::Expr> many_;  ///< the elements when there are two or more
+  sym::Expr one_ = nullptr;      ///< the element when there is at most one
+  size_t size_ = 0;
+};
+
 /// An array of symbolic expressions in row-major order; a scalar has an empty shape.
 struct Value {
   std::vector<int> shape;
-  std::vector<sym::Expr> elems;
+  ExprList elems;
 
   static Value scalar(sym::Expr e) { return {{}, {e}}; }
   bool isScalar() const { return shape.empty(); }
@@ -40,6 +96,7 @@ class Flattener {
   double lowerConstant(const ast::Expr& e, const char* what);
   std::vector<sym::Expr> iterationValues(const ast::Expr& range);
   sym::Expr timeDerivative(sym::Expr e, SourceRange where);
+  sym::Expr rateOf(sym::Expr symbol);
 
   [[noreturn]] void fail(SourceRange r, std::string code, std::string msg, std::string help = {});
 
@@ -51,13 +108,13 @@ class Flattener {
   FlatModel out_;
   size_t scalars_ = 0;
   sym::DirectionalDerivative timeDerivative_{ctx_};  ///< der(): memo shared by all calls
+  SourceRange derivativeSite_;                       ///< the der() being expanded (for E0311)
 
   std::unordered_map<const ast::Declaration*, Value> declValues_;
   std::unordered_set<const ast::Declaration*> inProgress_;
   std::unordered_set<const ast::Declaration*> failed_;  ///< already reported; later uses abort quietly
   std::vector<std::pair<std::string, sym::Expr>> iterators_;  ///< innermost last
-  std::vector<const Value*> endContext_;                      ///< arrays being subscripted (for `end`)
-  std::vector<int> endDim_;
+  std::vector<std::pair<const Value*, int>> endContext_;      ///< (array, dimension) being subscripted, for `end`
 
   // Flatten.cpp
   const Value& valueOf(const ast::Declaration& d, SourceRange use);
@@ -67,6 +124,7 @@ class Flattener {
   void applyAttributes(const ast::Declaration& d, const Value& vars);
   Value bindingValue(const ast::Declaration& d, const std::vector<int>& shape);
   int addVariable(Variable v);
+  void reserveVariables(size_t count);
   int derivativeVariable(int var, SourceRange where);
   void checkShape(const Value& v, const std::vector<int>& shape, SourceRange r, const std::string& what);
   void countScalars(size_t n, SourceRange r);
@@ -94,7 +152,11 @@ class Flattener {
   Value lowerIf(const ast::IfExpr& e);
   Value lowerRange(const ast::RangeExpr& e);
   Value stack(std::vector<Value> parts, SourceRange r);
+  class EndScope;
   std::vector<int> subscriptIndices(const ast::Expr& s, int dimSize);
+  int subscriptIndex(const ast::Expr& s, int dimSize);
+  void checkIndex(int i, int dimSize, const ast::Expr& s);
+  size_t elementOffset(const ast::IndexExpr& e, const Value& base);
   Value mapUnary(const Value& v, sym::Kind k);
 
   friend struct IteratorScope;

@@ -1,7 +1,8 @@
 // Euler–Lagrange rows and first integrals over an index from symbols to energy terms.
 #include "mechanics/EulerLagrange.h"
 
-#include <unordered_map>
+#include <span>
+#include <utility>
 
 namespace qdot::mech {
 namespace {
@@ -9,17 +10,36 @@ namespace {
 using flat::VarRole;
 using sym::Expr;
 
-/// The summands of an energy (T with +1, V with −1), each with the variables it contains.
-struct TermIndex {
+/// The summands of an energy (T with +1, V with −1), each with the variables it contains. The
+/// index from variables to terms is one flat array (CSR) built once all terms are in: a hash map of
+/// small vectors cost a heap block per variable.
+class TermIndex {
+ public:
   std::vector<Expr> terms;
-  std::unordered_map<int, std::vector<int>> byVariable;  ///< flat variable -> term ids
   bool dependsOnTime = false;
 
-  const std::vector<int>& termsOf(int var) const {
-    static const std::vector<int> none;
-    auto it = byVariable.find(var);
-    return it == byVariable.end() ? none : it->second;
+  /// Records that term `term` contains variable `var` (terms in increasing order).
+  void addOccurrence(int var, int term) { occurrences_.push_back({var, term}); }
+
+  /// Builds the index over `variableCount` variables; each variable's terms stay in increasing order.
+  void finish(size_t variableCount) {
+    offsets_.assign(variableCount + 1, 0);
+    for (const auto& [var, term] : occurrences_) ++offsets_[var + 1];
+    for (size_t v = 0; v < variableCount; ++v) offsets_[v + 1] += offsets_[v];
+    termIds_.resize(occurrences_.size());
+    std::vector<int> next(offsets_.begin(), offsets_.end() - 1);
+    for (const auto& [var, term] : occurrences_) termIds_[next[var]++] = term;
+    occurrences_ = {};
   }
+
+  std::span<const int> termsOf(int var) const {
+    return {termIds_.data() + offsets_[var], termIds_.data() + offsets_[var + 1]};
+  }
+
+ private:
+  std::vector<std::pair<int, int>> occurrences_;  ///< (variable, term) while terms are added
+  std::vector<int> offsets_;                      ///< size variables + 1
+  std::vector<int> termIds_;
 };
 
 class Deriver {
@@ -31,6 +51,8 @@ class Deriver {
     index(lagrangian_, m_.kinetic, 1.0);
     index(lagrangian_, m_.potential, -1.0);
     index(dissipation_, m_.dissipation, 1.0);
+    lagrangian_.finish(m_.variables.size());
+    dissipation_.finish(m_.variables.size());
     makeMultipliers();
     for (int q : m_.variablesWithRole(VarRole::Coordinate)) derive(q);
     if (diags_.errorCount() > errorsBefore) return std::nullopt;
@@ -46,7 +68,7 @@ class Deriver {
   sym::Context& ctx_;
   DiagnosticEngine& diags_;
   TermIndex lagrangian_, dissipation_;
-  std::unordered_map<int, std::vector<Expr>> forces_;
+  std::vector<std::vector<Expr>> forces_;  ///< by flat variable: the generalized forces on it
   EquationsOfMotion out_;
   std::optional<sym::DirectionalDerivative> timeDerivative_;  ///< d/dt, set up on first use
 
@@ -57,27 +79,38 @@ class Deriver {
   }
 
   // Splits every statement into its top-level summands and records which variables each contains.
+  // The summands hold exactly the statement's symbols, so the energy check looks at those; only a
+  // statement that fails it is walked again, to report its symbols in order of appearance.
   void index(TermIndex& idx, const std::vector<flat::Term>& terms, double sign) {
     for (const auto& t : terms) {
-      checkEnergyVariables(t);
       const sym::Node* e = t.value;
+      bool allowed = true;
       if (e->kind == sym::Kind::Add) {
-        for (size_t i = 0; i < e->args.size(); ++i) addTerm(idx, ctx_.scale(sign * e->coefs[i], e->args[i]));
+        for (size_t i = 0; i < e->args.size(); ++i) allowed &= addTerm(idx, ctx_.scale(sign * e->coefs[i], e->args[i]));
       } else if (!e->isConstant()) {
-        addTerm(idx, ctx_.scale(sign, e));
+        allowed = addTerm(idx, ctx_.scale(sign, e));
       }
+      if (!allowed) checkEnergyVariables(t);
     }
   }
 
-  void addTerm(TermIndex& idx, Expr term) {
+  // Returns false if the term contains a variable an energy may not depend on.
+  bool addTerm(TermIndex& idx, Expr term) {
     int id = static_cast<int>(idx.terms.size());
     idx.terms.push_back(term);
+    bool allowed = true;
     for (Expr s : ctx_.freeSymbols(term)) {
       int var = m_.variableOf(s);
       if (var < 0) continue;
+      allowed &= mayAppearInEnergy(m_.variables[var].role);
       if (m_.variables[var].role == VarRole::Time) idx.dependsOnTime = true;
-      idx.byVariable[var].push_back(id);
+      idx.addOccurrence(var, id);
     }
+    return allowed;
+  }
+
+  static bool mayAppearInEnergy(VarRole r) {
+    return r == VarRole::Coordinate || r == VarRole::Velocity || r == VarRole::Parameter || r == VarRole::Time;
   }
 
   // Energies may depend on coordinates, their velocities, parameters and time only.
@@ -86,12 +119,14 @@ class Deriver {
       int var = m_.variableOf(s);
       if (var < 0) continue;
       VarRole r = m_.variables[var].role;
-      if (r == VarRole::Coordinate || r == VarRole::Velocity || r == VarRole::Parameter || r == VarRole::Time) continue;
+      if (mayAppearInEnergy(r)) continue;
       diags_.error(t.range, "E0402",
-                   "this energy depends on '" + m_.variables[var].name + "', which is not a coordinate or its velocity",
-                   r == VarRole::Acceleration ? "energies cannot depend on accelerations"
-                                              : "declare it as 'coordinate Real " + m_.variables[var].name +
-                                                    "', or express it through the coordinates with a definition");
+                   "this energy depends on '" + std::string(m_.variables[var].name) +
+                       "', which is not a coordinate or its velocity",
+                   r == VarRole::Acceleration
+                       ? "energies cannot depend on accelerations"
+                       : "declare it as 'coordinate Real " + std::string(m_.variables[var].name) +
+                             "', or express it through the coordinates with a definition");
     }
   }
 
@@ -100,6 +135,7 @@ class Deriver {
       std::string name = "lambda[" + std::to_string(k + 1) + "]";
       out_.multipliers.push_back({name, ctx_.symbol(name), static_cast<int>(k)});
     }
+    forces_.resize(m_.variables.size());
     for (const auto& [q, term] : m_.forces) forces_[q].push_back(term.value);
   }
 
@@ -139,7 +175,8 @@ class Deriver {
     }
     Expr residual = ctx_.add(parts);
     if (lagrangian_.termsOf(q).empty() && lagrangian_.termsOf(v).empty() && forces_[q].empty() && !constrained) {
-      diags_.error(coord.declRange, "E0401", "coordinate '" + coord.name + "' appears in no energy, force or constraint",
+      diags_.error(coord.declRange, "E0401",
+                   "coordinate '" + std::string(coord.name) + "' appears in no energy, force or constraint",
                    "add its kinetic energy in the mechanics section, or declare it as a plain 'Real'");
       return;
     }
@@ -149,19 +186,19 @@ class Deriver {
 
   void findFirstIntegrals() {
     bool conservative = m_.dissipation.empty() && m_.forces.empty() && !lagrangian_.dependsOnTime;
-    std::vector<Expr> jacobi;
+    for (const auto& c : m_.constraints) conservative &= !ctx_.dependsOn(c.residual, m_.time());
+    std::vector<Expr> jacobi;  // Σ v ∂L/∂v, only built when the Jacobi integral exists
     for (const auto& row : out_.rows) {
       const flat::Variable& coord = m_.variables[row.coordinate];
       int v = coord.derivative;
-      jacobi.push_back(ctx_.mul(m_.variables[v].symbol, row.momentum));
+      if (conservative) jacobi.push_back(ctx_.mul(m_.variables[v].symbol, row.momentum));
       bool cyclic = lagrangian_.termsOf(row.coordinate).empty() && forces_[row.coordinate].empty() &&
                     dissipation_.termsOf(v).empty() && !row.momentum->isZero();
       for (const auto& c : m_.constraints) cyclic &= !ctx_.dependsOn(c.residual, coord.symbol);
       if (cyclic)
-        out_.integrals.push_back({FirstIntegral::Kind::CyclicMomentum, row.coordinate, "p(" + coord.name + ")", row.momentum});
+        out_.integrals.push_back(
+            {FirstIntegral::Kind::CyclicMomentum, row.coordinate, "p(" + std::string(coord.name) + ")", row.momentum});
     }
-    for (const auto& c : m_.constraints)
-      conservative &= !ctx_.dependsOn(c.residual, m_.variables[m_.byName.at("time")].symbol);
     if (!conservative) return;
     jacobi.push_back(ctx_.neg(ctx_.add(lagrangian_.terms)));
     out_.integrals.push_back({FirstIntegral::Kind::Jacobi, -1, "jacobi", ctx_.add(jacobi)});
