@@ -13,7 +13,8 @@ struct JacobianEntries {
   std::vector<sym::Expr> values;      ///< one expression per nonzero, in CSC order (uses the symbol cj)
 };
 
-/// Differentiates every residual with respect to the variables it mentions (O(nonzeros) calls to diff).
+/// Differentiates every residual with respect to the variables it mentions: one sparse forward pass
+/// (sym::PartialDerivatives), O(Σ over the residuals' nodes of the unknowns each contains).
 JacobianEntries differentiate(const dae::Dae& dae, sym::Context& ctx, sym::Expr cj);
 
 }  // namespace qdot::kernel

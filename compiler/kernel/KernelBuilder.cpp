@@ -98,6 +98,10 @@ class Builder {
   }
 
   void addEquationSources() {
+    // Roughly one source per equation, per variable's start and nominal value, per parameter ...:
+    // reserved, as a large model has hundreds of thousands (each with two strings to move on growth).
+    m_.sources.reserve(dae_.equations.size() + 2 * dae_.variables.size() + dae_.parameters.size() +
+                       dae_.initialEquations.size() + dae_.outputs.size() + dae_.invariants.size());
     for (size_t i = 0; i < dae_.equations.size(); ++i) {
       const auto& e = dae_.equations[i];
       equationSource_.push_back(addSource(equationLabel(i, e), e.origin.range, equationText(e)));

@@ -59,9 +59,14 @@ uint32_t ProgramBuilder::emit(Op op, uint32_t a, uint32_t b, uint32_t c, uint32_
   return static_cast<uint32_t>(program_.code.size() - 1);
 }
 
+// The pool key of v: -0 is 0, every NaN is the quiet NaN.
+uint64_t ProgramBuilder::constantBits(double v) {
+  if (std::isnan(v)) return std::bit_cast<uint64_t>(std::numeric_limits<double>::quiet_NaN());
+  return std::bit_cast<uint64_t>(v == 0.0 ? 0.0 : v);
+}
+
 uint32_t ProgramBuilder::constant(double v) {
-  uint64_t bits = std::bit_cast<uint64_t>(v == 0.0 ? 0.0 : v);
-  if (std::isnan(v)) bits = std::bit_cast<uint64_t>(std::numeric_limits<double>::quiet_NaN());
+  uint64_t bits = constantBits(v);
   auto it = constants_.find(bits);
   if (it != constants_.end()) return it->second;
   auto index = static_cast<uint32_t>(program_.constants.size());
@@ -71,40 +76,53 @@ uint32_t ProgramBuilder::constant(double v) {
   return r;
 }
 
-// Children that need registers: arguments, non-constant exponents, a temporary's value.
-void ProgramBuilder::pushChildren(sym::Expr e, std::vector<std::pair<sym::Expr, bool>>& stack) {
-  std::vector<sym::Expr> kids;
-  if (e->isSymbol()) {
-    auto t = temporaries_.find(e);
-    if (t != temporaries_.end()) kids.push_back(t->second);
-  } else if (e->kind == sym::Kind::Pow) {
-    kids.push_back(e->args[0]);
-    if (!e->args[1]->isConstant()) kids.push_back(e->args[1]);
-  } else {
-    kids.assign(e->args.begin(), e->args.end());
-    for (sym::Expr x : e->exps)
-      if (!x->isConstant()) kids.push_back(x);
+// Symbols by id, constants by value (the pool's own map: one `ldk` per bit pattern), other nodes in
+// the memo.
+const uint32_t* ProgramBuilder::known(sym::Expr e) const {
+  if (e->isConstant()) {
+    auto it = constants_.find(constantBits(e->value));
+    return it == constants_.end() ? nullptr : &it->second;
   }
-  for (auto it = kids.rbegin(); it != kids.rend(); ++it)
-    if (!memo_.count(*it)) stack.emplace_back(*it, false);
+  if (!e->isSymbol()) return memo_.find(e);
+  return e->symbolId < symbolRegs_.size() && symbolRegs_[e->symbolId] != kNone ? &symbolRegs_[e->symbolId] : nullptr;
 }
 
-uint32_t ProgramBuilder::lower(sym::Expr root) {
-  if (auto it = memo_.find(root); it != memo_.end()) return it->second;
-  std::vector<std::pair<sym::Expr, bool>> stack{{root, false}};
-  while (!stack.empty()) {
-    auto [e, expanded] = stack.back();
-    if (memo_.count(e)) {
-      stack.pop_back();
-    } else if (!expanded) {
-      stack.back().second = true;
-      pushChildren(e, stack);
-    } else {
-      stack.pop_back();
-      memo_[e] = emitNode(e);
-    }
+void ProgramBuilder::remember(sym::Expr e, uint32_t reg) {
+  if (e->isConstant()) return;  // constant() keeps it
+  if (e->isSymbol()) slot(symbolRegs_, e, kNone) = reg;
+  else memo_.insert(e, reg);
+}
+
+// The next child of f.node that needs a register (arguments, non-constant exponents, a
+// temporary's value), or nullptr when there is none left.
+sym::Expr ProgramBuilder::nextChild(Frame& f) const {
+  sym::Expr e = f.node;
+  if (e->isSymbol()) return f.next++ == 0 ? find(temporaries_, e, sym::Expr{nullptr}) : nullptr;
+  while (f.next < e->args.size() + e->exps.size()) {
+    size_t i = f.next++;
+    sym::Expr c = e->args.data()[i];  // args, then exps (one array)
+    bool exponent = e->kind == sym::Kind::Pow ? i == 1 : i >= e->args.size();
+    if (!exponent || !c->isConstant()) return c;
   }
-  return memo_.at(root);
+  return nullptr;
+}
+
+// Post-order: children first to last, each finished before the next is looked at.
+uint32_t ProgramBuilder::lower(sym::Expr root) {
+  if (const uint32_t* r = known(root)) return *r;
+  frames_.assign(1, {root, 0});
+  while (!frames_.empty()) {
+    Frame& f = frames_.back();
+    if (sym::Expr c = nextChild(f)) {
+      if (!known(c)) frames_.push_back({c, 0});
+      continue;
+    }
+    sym::Expr e = f.node;
+    frames_.pop_back();
+    uint32_t r = emitNode(e);
+    remember(e, r);
+  }
+  return reg(root);
 }
 
 uint32_t ProgramBuilder::emitNode(sym::Expr e) {
@@ -123,8 +141,8 @@ uint32_t ProgramBuilder::emitNode(sym::Expr e) {
 }
 
 uint32_t ProgramBuilder::emitSymbol(sym::Expr e) {
-  if (auto t = temporaries_.find(e); t != temporaries_.end()) return reg(t->second);
-  if (auto l = loads_.find(e); l != loads_.end()) return emit(l->second.first, 0, 0, 0, l->second.second);
+  if (sym::Expr t = find(temporaries_, e, sym::Expr{nullptr})) return reg(t);
+  if (Load l = find(loads_, e, kNoLoad); l.second != kNone) return emit(l.first, 0, 0, 0, l.second);
   unbound_.push_back(e);
   return constant(std::numeric_limits<double>::quiet_NaN());
 }

@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "kernel/Kernel.h"
+#include "symbolic/NodeMap.h"
 
 namespace qdot::kernel {
 
@@ -17,11 +18,11 @@ class ProgramBuilder {
   explicit ProgramBuilder(std::string name) { program_.name = std::move(name); }
 
   /// `symbol` reads input `index` with a load opcode (emitted when first used).
-  void bindLoad(sym::Expr symbol, Op load, uint32_t index) { loads_[symbol] = {load, index}; }
+  void bindLoad(sym::Expr symbol, Op load, uint32_t index) { slot(loads_, symbol, kNoLoad) = {load, index}; }
   /// `symbol` is the value already in register `reg`.
-  void bindRegister(sym::Expr symbol, uint32_t reg) { memo_[symbol] = reg; }
+  void bindRegister(sym::Expr symbol, uint32_t reg) { slot(symbolRegs_, symbol, kNone) = reg; }
   /// `symbol` is a CSE temporary standing for `value` (lowered when first used).
-  void bindTemporary(sym::Expr symbol, sym::Expr value) { temporaries_[symbol] = value; }
+  void bindTemporary(sym::Expr symbol, sym::Expr value) { slot(temporaries_, symbol, sym::Expr{nullptr}) = value; }
 
   /// Instructions emitted from now on serve source `s`.
   void setSource(uint32_t s) { source_ = s; }
@@ -39,22 +40,45 @@ class ProgramBuilder {
   Program finish(uint32_t outputCount);
 
  private:
-  void pushChildren(sym::Expr e, std::vector<std::pair<sym::Expr, bool>>& stack);
+  // What a symbol stands for (a temporary wins over a load) and its register once known, by symbol
+  // id: a model binds every y and y' of the DAE, hundreds of thousands of them for large models,
+  // and symbols are the most used nodes. Separate arrays: the register, looked up most, stays dense.
+  using Load = std::pair<Op, uint32_t>;  // index kNone: no load
+  static constexpr Load kNoLoad{Op::Ret, kNone};
+  template <class T>
+  static T& slot(std::vector<T>& bySymbol, sym::Expr symbol, T none) {
+    if (bySymbol.size() <= symbol->symbolId) bySymbol.resize(symbol->symbolId + 1, none);
+    return bySymbol[symbol->symbolId];
+  }
+  template <class T>
+  static T find(const std::vector<T>& bySymbol, sym::Expr symbol, T none) {
+    return symbol->symbolId < bySymbol.size() ? bySymbol[symbol->symbolId] : none;
+  }
+  struct Frame {
+    sym::Expr node;
+    size_t next;  // next child to look at
+  };
+  sym::Expr nextChild(Frame& f) const;
   uint32_t emitNode(sym::Expr e);
   uint32_t emitSymbol(sym::Expr e);
   uint32_t emitAdd(sym::Expr e);
   uint32_t emitMul(sym::Expr e);
   uint32_t emitPow(sym::Expr e);
   uint32_t power(uint32_t base, double exponent);
-  uint32_t reg(sym::Expr e) const { return memo_.at(e); }
+  static uint64_t constantBits(double v);
+  const uint32_t* known(sym::Expr e) const;
+  void remember(sym::Expr e, uint32_t reg);
+  uint32_t reg(sym::Expr e) const { return *known(e); }
 
   Program program_;
   uint32_t source_ = UINT32_MAX;
-  std::unordered_map<sym::Expr, uint32_t> memo_;
-  std::unordered_map<sym::Expr, std::pair<Op, uint32_t>> loads_;
-  std::unordered_map<sym::Expr, sym::Expr> temporaries_;
+  sym::NodeMap<uint32_t> memo_;                       // node (not a leaf) -> register
+  std::vector<uint32_t> symbolRegs_;                  // by symbolId; kNone: not lowered yet
+  std::vector<sym::Expr> temporaries_;                // by symbolId
+  std::vector<Load> loads_;                           // by symbolId
   std::unordered_map<uint64_t, uint32_t> constants_;  // bit pattern -> register
   std::vector<sym::Expr> unbound_;
+  std::vector<Frame> frames_;  // lower()'s stack, kept to reuse its storage
 };
 
 /// The opcode of a function kind (Sin … Select); Ret for kinds that are not functions.

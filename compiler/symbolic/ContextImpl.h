@@ -24,6 +24,19 @@ namespace qdot::sym {
 inline size_t childCount(Expr n) { return n->args.size() + n->exps.size(); }
 inline std::span<const Expr> children(Expr n) { return {n->args.data(), childCount(n)}; }
 inline Expr child(Expr n, size_t i) { return n->args.data()[i]; }
+/// Starts loading a node and its operands (they follow the node in the arena).
+inline void prefetchNode(Expr n) {
+  __builtin_prefetch(n);
+  __builtin_prefetch(reinterpret_cast<const char*>(n) + sizeof(Node));
+}
+/// Before walking n's children: starts loading each child and its entry in `map`.
+template <class Map>
+void prefetchChildren(Expr n, const Map& map) {
+  for (Expr c : children(n)) {
+    prefetchNode(c);
+    map.prefetch(c);
+  }
+}
 
 /// Arity from ExprKinds.def (-1 = n-ary).
 int kindArity(Kind k);

@@ -1,37 +1,30 @@
-// Symbolic differentiation: one rule per kind (the switch in `rule` has no default, so a new kind
-// without a rule triggers -Wswitch), applied along a Direction: the rate at which each symbol moves.
-// Context::diff is the direction {s -> 1}; DirectionalDerivative is any field {s -> rate(s)} (d/dt).
-// One iterative post-order walk serves both, memoising per node and skipping nodes whose symbol mask
-// misses every moving symbol; the memo doubles as the visited set, so a call costs O(new nodes).
+// Symbolic differentiation: one rule per kind (the switch in `applyRule` has no default, so a new
+// kind without a rule triggers -Wswitch), applied along a Direction: the rate at which each symbol
+// moves. Context::diff is the direction {s -> 1}; DirectionalDerivative is any field
+// {s -> rate(s)} (d/dt). One iterative post-order walk serves both, memoising per node and skipping
+// nodes whose symbol mask misses every moving symbol; the memo doubles as the visited set, so a call
+// costs O(new nodes). PartialDerivatives (Gradient.cpp) applies the same rules in a sparse pass.
 #include <stdexcept>
 
-#include "symbolic/ContextImpl.h"
+#include "symbolic/DerivativeRules.h"
 
 namespace qdot::sym {
 
 namespace {
 
-// What the derivative is taken along: rate(s) for every symbol; `mask` has the bits of every symbol
-// whose rate may be non-zero (all bits when rates are only known on demand).
-struct Direction {
-  uint64_t mask = 0;
-  virtual Expr rate(Expr symbol) = 0;
+// Fast paths below rely on canonical nodes being fixed points of the builders: MulBuilder over the
+// one factor x gives x, and AddBuilder over the one term 1·x gives x unless x = k·(sum), which it
+// distributes (tested in BuilderFixedPointTest). They skip a builder, never change a result.
 
- protected:
-  ~Direction() = default;
-};
-
-// What a rule sees: the Context, the direction, and the derivatives of the node's children.
-struct Diff {
-  Context& ctx;
-  Direction& dir;
-  NodeMap<Expr>& memo;
-
-  bool mayMove(Expr c) const { return (c->symbolMask & dir.mask) != 0; }
-  Expr d(Expr c) const { return mayMove(c) ? *memo.find(c) : ctx.zero(); }
-  Expr chain(Expr outer, Expr du) const { return du->isZero() ? du : ctx.mul(outer, du); }
-  Expr square(Expr u) const { return ctx.pow(u, ctx.constant(2.0)); }
-};
+// What AddBuilder makes of the single term 1·x.
+Expr sumOfOne(Context& ctx, Expr x) {
+  bool scaledSum = x->kind == Kind::Mul && x->value != 1.0 && x->args.size() == 1 && x->exps[0]->isOne() &&
+                   x->args[0]->kind == Kind::Add;
+  if (!scaledSum) return x;
+  AddBuilder sum(ctx);
+  sum.add(1.0, x);
+  return sum.build();
+}
 
 Expr minusOne(Expr e, Context& ctx) {
   return e->isConstant() ? ctx.constant(e->value - 1.0) : ctx.sub(e, ctx.one());
@@ -39,11 +32,11 @@ Expr minusOne(Expr e, Context& ctx) {
 
 // d(b^e) = e*b^(e-1)*db + b^e*log(b)*de; only the first term when e does not move.
 // `self` is b^e (the Pow node, or nullptr to build it when needed).
-Expr powRule(const Diff& D, Expr b, Expr e, Expr self) {
-  Context& ctx = D.ctx;
-  Expr db = D.d(b), de = D.d(e);
+Expr powRule(Context& ctx, Expr b, Expr e, Expr db, Expr de, Expr self) {
   Expr first = ctx.zero();
-  if (!db->isZero()) {
+  if (!db->isZero() && e->isOne()) {
+    first = db;  // 1 * b^0 * db
+  } else if (!db->isZero()) {
     MulBuilder m(ctx);
     m.factor(e);
     m.power(b, minusOne(e, ctx));
@@ -57,124 +50,152 @@ Expr powRule(const Diff& D, Expr b, Expr e, Expr self) {
   return ctx.add(first, second);
 }
 
-Expr dConstant(const Diff& D, Expr) { return D.ctx.zero(); }
-Expr dSymbol(const Diff& D, Expr n) { return D.dir.rate(n); }
+Expr dConstant(const Diff& D) { return D.ctx.zero(); }
+Expr dSymbol(const Diff& D) { return D.dir->rate(D.node); }
 
-Expr dAdd(const Diff& D, Expr n) {
-  AddBuilder sum(D.ctx);
-  for (size_t i = 0; i < n->args.size(); ++i)
-    if (Expr d = D.d(n->args[i]); !d->isZero()) sum.add(n->coefs[i], d);
+// Σ coef·term over non-zero terms; one term with coefficient 1 (one moving term of a sum, one
+// moving factor of a product: the usual case) skips most of the AddBuilder.
+class TermSum {
+ public:
+  explicit TermSum(Context& ctx) : ctx_(ctx), sum_(ctx) {}
+  void add(double coef, Expr term) {
+    if (count_++ == 0) first_ = {term, coef};
+    else if (count_ == 2) sum_.add(first_.coef, first_.e);
+    if (count_ > 1) sum_.add(coef, term);
+  }
+  Expr build() {
+    if (count_ == 1 && first_.coef == 1.0) return sumOfOne(ctx_, first_.e);
+    if (count_ == 1) sum_.add(first_.coef, first_.e);
+    return sum_.build();
+  }
+
+ private:
+  Context& ctx_;
+  AddBuilder sum_;
+  AddBuilder::Term first_{};
+  size_t count_ = 0;
+};
+
+Expr dAdd(const Diff& D) {
+  Expr n = D.node;
+  TermSum sum(D.ctx);
+  D.forEachMoving([&](size_t i) {
+    if (Expr d = D.d(i); !d->isZero()) sum.add(n->coefs[i], d);
+  });
   return sum.build();
 }
 
 // Product rule over the factors that may move: Σ_i (Π_{j≠i} f_j) * d(f_i).
-Expr dMul(const Diff& D, Expr n) {
-  AddBuilder sum(D.ctx);
+Expr dMul(const Diff& D) {
+  Expr n = D.node;
+  TermSum sum(D.ctx);
   size_t m = n->args.size();
-  for (size_t i = 0; i < m; ++i) {
-    Expr b = n->args[i], e = n->exps[i];
-    if (!D.mayMove(b) && !D.mayMove(e)) continue;
-    Expr dFactor = powRule(D, b, e, nullptr);
-    if (dFactor->isZero()) continue;  // the mask only said "maybe"
+  D.forEachMoving([&](size_t i) {
+    Expr dFactor = powRule(D.ctx, n->args[i], n->exps[i], D.d(i), D.d(m + i), nullptr);
+    if (dFactor->isZero()) return;  // the mask only said "maybe"
     MulBuilder term(D.ctx, n->value);
     for (size_t j = 0; j < m; ++j)
       if (j != i) term.pair(n->args[j], n->exps[j]);
     term.factor(dFactor);
     sum.add(1.0, term.build());
-  }
+  });
   return sum.build();
 }
 
-Expr dPow(const Diff& D, Expr n) { return powRule(D, n->args[0], n->args[1], n); }
+Expr dPow(const Diff& D) { return powRule(D.ctx, D.node->args[0], D.node->args[1], D.d(0), D.d(1), D.node); }
 
-Expr dSin(const Diff& D, Expr n) { return D.chain(D.ctx.unary(Kind::Cos, n->args[0]), D.d(n->args[0])); }
-Expr dCos(const Diff& D, Expr n) {
-  return D.chain(D.ctx.neg(D.ctx.unary(Kind::Sin, n->args[0])), D.d(n->args[0]));
-}
+// The rules of one-argument functions: u = the argument, du = its derivative.
+Expr dSin(const Diff& D, Expr u, Expr du) { return D.chain(D.ctx.unary(Kind::Cos, u), du); }
+Expr dCos(const Diff& D, Expr u, Expr du) { return D.chain(D.ctx.neg(D.ctx.unary(Kind::Sin, u)), du); }
 // tan' = 1 + tan^2, tanh' = 1 - tanh^2: reuse the node itself.
-Expr dTan(const Diff& D, Expr n) { return D.chain(D.ctx.add(D.ctx.one(), D.square(n)), D.d(n->args[0])); }
-Expr dTanh(const Diff& D, Expr n) { return D.chain(D.ctx.sub(D.ctx.one(), D.square(n)), D.d(n->args[0])); }
-Expr dAsin(const Diff& D, Expr n) {
+Expr dTan(const Diff& D, Expr, Expr du) { return D.chain(D.ctx.add(D.ctx.one(), D.square(D.node)), du); }
+Expr dTanh(const Diff& D, Expr, Expr du) { return D.chain(D.ctx.sub(D.ctx.one(), D.square(D.node)), du); }
+Expr dAsin(const Diff& D, Expr u, Expr du) {
   Context& c = D.ctx;
-  Expr root = c.pow(c.sub(c.one(), D.square(n->args[0])), c.constant(-0.5));
-  return D.chain(root, D.d(n->args[0]));
+  Expr root = c.pow(c.sub(c.one(), D.square(u)), c.constant(-0.5));
+  return D.chain(root, du);
 }
-Expr dAcos(const Diff& D, Expr n) {
+Expr dAcos(const Diff& D, Expr u, Expr du) {
   Context& c = D.ctx;
-  Expr root = c.pow(c.sub(c.one(), D.square(n->args[0])), c.constant(-0.5));
-  return D.chain(c.neg(root), D.d(n->args[0]));
+  Expr root = c.pow(c.sub(c.one(), D.square(u)), c.constant(-0.5));
+  return D.chain(c.neg(root), du);
 }
-Expr dAtan(const Diff& D, Expr n) {
+Expr dAtan(const Diff& D, Expr u, Expr du) {
   Context& c = D.ctx;
-  return D.chain(c.pow(c.add(c.one(), D.square(n->args[0])), c.constant(-1.0)), D.d(n->args[0]));
+  return D.chain(c.pow(c.add(c.one(), D.square(u)), c.constant(-1.0)), du);
 }
-Expr dSinh(const Diff& D, Expr n) { return D.chain(D.ctx.unary(Kind::Cosh, n->args[0]), D.d(n->args[0])); }
-Expr dCosh(const Diff& D, Expr n) { return D.chain(D.ctx.unary(Kind::Sinh, n->args[0]), D.d(n->args[0])); }
-Expr dExp(const Diff& D, Expr n) { return D.chain(n, D.d(n->args[0])); }
-Expr dLog(const Diff& D, Expr n) { return D.ctx.div(D.d(n->args[0]), n->args[0]); }
-Expr dAbs(const Diff& D, Expr n) { return D.chain(D.ctx.unary(Kind::Sign, n->args[0]), D.d(n->args[0])); }
+Expr dSinh(const Diff& D, Expr u, Expr du) { return D.chain(D.ctx.unary(Kind::Cosh, u), du); }
+Expr dCosh(const Diff& D, Expr u, Expr du) { return D.chain(D.ctx.unary(Kind::Sinh, u), du); }
+Expr dExp(const Diff& D, Expr, Expr du) { return D.chain(D.node, du); }
+Expr dLog(const Diff& D, Expr u, Expr du) { return D.ctx.div(du, u); }
+Expr dAbs(const Diff& D, Expr u, Expr du) { return D.chain(D.ctx.unary(Kind::Sign, u), du); }
 
 // atan2(y, x)' = (x*dy - y*dx) / (x^2 + y^2)
-Expr dAtan2(const Diff& D, Expr n) {
+Expr dAtan2(const Diff& D) {
   Context& c = D.ctx;
-  Expr y = n->args[0], x = n->args[1];
-  Expr num = c.sub(c.mul(x, D.d(y)), c.mul(y, D.d(x)));
+  Expr y = D.node->args[0], x = D.node->args[1];
+  Expr num = c.sub(c.mul(x, D.d(0)), c.mul(y, D.d(1)));
   return c.div(num, c.add(D.square(x), D.square(y)));
 }
 // min(a, b)' = if a <= b then a' else b';  max(a, b)' = if b <= a then a' else b'
-Expr dMin(const Diff& D, Expr n) {
-  Expr a = n->args[0], b = n->args[1];
-  return D.ctx.select(D.ctx.binary(Kind::Le, a, b), D.d(a), D.d(b));
+Expr dMin(const Diff& D) {
+  Expr a = D.node->args[0], b = D.node->args[1];
+  return D.ctx.select(D.ctx.binary(Kind::Le, a, b), D.d(0), D.d(1));
 }
-Expr dMax(const Diff& D, Expr n) {
-  Expr a = n->args[0], b = n->args[1];
-  return D.ctx.select(D.ctx.binary(Kind::Le, b, a), D.d(a), D.d(b));
+Expr dMax(const Diff& D) {
+  Expr a = D.node->args[0], b = D.node->args[1];
+  return D.ctx.select(D.ctx.binary(Kind::Le, b, a), D.d(0), D.d(1));
 }
 // Sign and the Boolean-valued kinds are piecewise constant.
-Expr dPiecewiseConstant(const Diff& D, Expr) { return D.ctx.zero(); }
-Expr dSelect(const Diff& D, Expr n) { return D.ctx.select(n->args[0], D.d(n->args[1]), D.d(n->args[2])); }
+Expr dPiecewiseConstant(const Diff& D) { return D.ctx.zero(); }
+Expr dSelect(const Diff& D) { return D.ctx.select(D.node->args[0], D.d(1), D.d(2)); }
 
-Expr rule(const Diff& D, Expr n) {
-  switch (n->kind) {
-    case Kind::Constant: return dConstant(D, n);
-    case Kind::Symbol: return dSymbol(D, n);
-    case Kind::Add: return dAdd(D, n);
-    case Kind::Mul: return dMul(D, n);
-    case Kind::Pow: return dPow(D, n);
-    case Kind::Sin: return dSin(D, n);
-    case Kind::Cos: return dCos(D, n);
-    case Kind::Tan: return dTan(D, n);
-    case Kind::Asin: return dAsin(D, n);
-    case Kind::Acos: return dAcos(D, n);
-    case Kind::Atan: return dAtan(D, n);
-    case Kind::Sinh: return dSinh(D, n);
-    case Kind::Cosh: return dCosh(D, n);
-    case Kind::Tanh: return dTanh(D, n);
-    case Kind::Exp: return dExp(D, n);
-    case Kind::Log: return dLog(D, n);
-    case Kind::Abs: return dAbs(D, n);
-    case Kind::Sign: return dPiecewiseConstant(D, n);
-    case Kind::Atan2: return dAtan2(D, n);
-    case Kind::Min: return dMin(D, n);
-    case Kind::Max: return dMax(D, n);
+}  // namespace
+
+Expr applyRule(const Diff& D) {
+  Expr u = D.node->args.empty() ? nullptr : D.node->args[0];
+  auto unary = [&](Expr (*rule)(const Diff&, Expr, Expr)) { return rule(D, u, D.d(0)); };
+  switch (D.node->kind) {
+    case Kind::Constant: return dConstant(D);
+    case Kind::Symbol: return dSymbol(D);
+    case Kind::Add: return dAdd(D);
+    case Kind::Mul: return dMul(D);
+    case Kind::Pow: return dPow(D);
+    case Kind::Sin: return unary(dSin);
+    case Kind::Cos: return unary(dCos);
+    case Kind::Tan: return unary(dTan);
+    case Kind::Asin: return unary(dAsin);
+    case Kind::Acos: return unary(dAcos);
+    case Kind::Atan: return unary(dAtan);
+    case Kind::Sinh: return unary(dSinh);
+    case Kind::Cosh: return unary(dCosh);
+    case Kind::Tanh: return unary(dTanh);
+    case Kind::Exp: return unary(dExp);
+    case Kind::Log: return unary(dLog);
+    case Kind::Abs: return unary(dAbs);
+    case Kind::Sign: return dPiecewiseConstant(D);
+    case Kind::Atan2: return dAtan2(D);
+    case Kind::Min: return dMin(D);
+    case Kind::Max: return dMax(D);
     case Kind::Lt:
     case Kind::Le:
     case Kind::Eq:
     case Kind::Ne:
     case Kind::And:
     case Kind::Or:
-    case Kind::Not: return dPiecewiseConstant(D, n);
-    case Kind::Select: return dSelect(D, n);
+    case Kind::Not: return dPiecewiseConstant(D);
+    case Kind::Select: return dSelect(D);
   }
   throw std::logic_error("diff: corrupt node kind");
 }
+
+namespace {
 
 // The derivative of e along dir: post-order over the nodes that may move and have no memo yet.
 // A child is finished (memoised) before its next sibling is looked at. If dir.rate throws, only
 // finished nodes are in the memo, so it stays valid.
 Expr differentiate(Context& ctx, Direction& dir, NodeMap<Expr>& memo, Expr e) {
-  Diff D{ctx, dir, memo};
-  if (!D.mayMove(e)) return ctx.zero();
+  if (!(e->symbolMask & dir.mask)) return ctx.zero();
   if (Expr* known = memo.find(e)) return *known;
   struct Frame {
     Expr node;
@@ -186,11 +207,11 @@ Expr differentiate(Context& ctx, Direction& dir, NodeMap<Expr>& memo, Expr e) {
     Frame& f = stack.back();
     if (f.next < childCount(f.node)) {
       Expr c = child(f.node, f.next++);
-      if (D.mayMove(c) && !memo.find(c)) stack.push_back({c, 0});
+      if ((c->symbolMask & dir.mask) && !memo.find(c)) stack.push_back({c, 0});
     } else {
       Expr node = f.node;
       stack.pop_back();
-      memo.insert(node, rule(D, node));
+      memo.insert(node, applyRule(Diff{.ctx = ctx, .node = node, .dir = &dir, .memo = &memo}));
     }
   }
   return *memo.find(e);

@@ -173,6 +173,35 @@ class DirectionalDerivative {
   std::unique_ptr<Impl> impl_;
 };
 
+// --- partial derivatives for Jacobians -----------------------------------------------------------
+
+/// ∂e/∂s for many expressions e and a fixed list of distinct symbols s (a Jacobian's unknowns), in
+/// one sparse forward pass: every node gets, once, the list of listed symbols it contains and its
+/// derivative with respect to each, from its children's. Gives the nodes Context::diff gives, but
+/// costs O(Σ over nodes of the symbols they contain) instead of visiting, for every symbol, every
+/// node that shares its mask bit (with more than 64 symbols the bits alias, and Context::diff then
+/// revisits wide sums once per symbol). Keeps its results (not Context::diff's memo).
+class PartialDerivatives {
+ public:
+  PartialDerivatives(Context& ctx, std::span<const Expr> symbols);
+  ~PartialDerivatives();
+  PartialDerivatives(const PartialDerivatives&) = delete;
+  PartialDerivatives& operator=(const PartialDerivatives&) = delete;
+
+  /// Positions (in `symbols`) of the symbols that occur in e, ascending.
+  std::span<const uint32_t> symbolsIn(Expr e);
+  /// ∂e/∂symbols[k] for every k in symbolsIn(e), in that order (some may be zero: sign(x)).
+  /// Both spans stay valid until a call reaches nodes not seen before.
+  std::span<const Expr> gradient(Expr e);
+  /// ∂e/∂symbols[position] (zero if e does not contain it).
+  Expr diff(Expr e, uint32_t position);
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
 // --- evaluation --------------------------------------------------------------------------------
 
 /// Evaluates e with symbol values indexed by symbolId (values.size() >= symbolCount(); precisely,
