@@ -2,8 +2,8 @@
 //   eval_bench MODEL.qd [--repeat R] [--no-llvm] [--no-eval] [--calls N] [--min-time S]
 // Compiles the file R times (best of R per stage): the front end (parse .. dae, driver::compileFile,
 // as qdot run), kernel::buildKernels, then each backend's code generation — bytecode::emitBytecode +
-// vm::createModel, and llvmbackend::createJitModel(kernels, sources, 2, error) exactly as
-// `qdot run --backend llvm`. Then (unless --no-eval) times model->residual and model->jacobian of
+// vm::createModel, and llvmbackend::createJitModel with the default options, as
+// `qdot run --jit-wait`. Then (unless --no-eval) times model->residual and model->jacobian of
 // both models on one fixed state (y = y0 + 0.01 (i mod 17), y' = 0.02 (i mod 5), cj = 10): calls
 // in batches until --min-time seconds have passed, best of 3 batches, in ns per call; and checks
 // that both backends return the same F and J (max |difference|). With --calls N each of the four
@@ -154,7 +154,7 @@ int main(int argc, char** argv) {
     vmModel = ModelPtr{vm, vm->destroy};
     if (!noLlvm) {
       llvmbackend::JitStats stats;
-      llvmbackend::JitOptions options;  // the defaults = createJitModel(k, sm, 2, error)
+      llvmbackend::JitOptions options;  // the defaults, as qdot run
       t0 = Clock::now();
       QdotModel* jit = llvmbackend::createJitModel(kernels, c.sources, options, error, &stats);
       llvm = std::min(llvm, secondsSince(t0));

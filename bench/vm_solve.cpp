@@ -56,9 +56,7 @@ Compiled compile(const std::string& file, const std::string& backend, bool invar
   QdotModel* model = nullptr;
   if (backend == "llvm") {
 #ifdef QDOT_BENCH_LLVM
-    llvmbackend::JitOptions jit;  // as qdot run (driver/main.cpp jitOptionsFor)
-    if (!invariants) jit.compiledPrograms &= ~llvmbackend::programBit(kernel::ProgramId::Invariants);
-    model = llvmbackend::createJitModel(kernels, c.sources, jit, error);
+    model = llvmbackend::createJitModel(kernels, c.sources, llvmbackend::jitOptionsForRun(invariants), error);
 #else
     throw std::runtime_error("built without the LLVM backend");
 #endif

@@ -74,14 +74,6 @@ int runEquations(const Options& o) {
   return finish(c, ok);
 }
 
-// What the JIT compiles for one run: residual, Jacobian and outputs always, the invariants only
-// when they are asked for; parameters and start values run once, on the kernel interpreter.
-llvmbackend::JitOptions jitOptionsFor(const rt::RunOptions& run) {
-  llvmbackend::JitOptions options;
-  if (!run.invariants) options.compiledPrograms &= ~llvmbackend::programBit(kernel::ProgramId::Invariants);
-  return options;
-}
-
 // How the JIT compiled (--stats).
 void printJitStats(const llvmbackend::JitStats& jit) {
   uint32_t functions = 0;
@@ -128,7 +120,7 @@ struct CompiledModel {
 CompiledModel compileModel(const kernel::KernelModule& kernels, const SourceManager& sources, const Options& o) {
   CompiledModel out;
   if (o.backend == "llvm" && o.jitWait) {
-    out.model = llvmbackend::createJitModel(kernels, sources, jitOptionsFor(o.run), out.jit->error, &out.jit->stats);
+    out.model = llvmbackend::createJitModel(kernels, sources, llvmbackend::jitOptionsForRun(o.run.invariants), out.jit->error, &out.jit->stats);
     out.what = "llvm";
     out.waited = true;
     if (out.model) return out;
@@ -141,7 +133,7 @@ CompiledModel compileModel(const kernel::KernelModule& kernels, const SourceMana
     out.model = vmModel;
     return out;
   }
-  llvmbackend::JitOptions options = jitOptionsFor(o.run);
+  llvmbackend::JitOptions options = llvmbackend::jitOptionsForRun(o.run.invariants);
   options.threads = std::max(2u, std::thread::hardware_concurrency()) - 1;  // one core keeps solving
   out.what = "bytecode then llvm";
   out.model = rt::createTieredModel(vmModel, [&kernels, &sources, options, jit = out.jit](const std::atomic<bool>& cancel) {

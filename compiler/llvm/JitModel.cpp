@@ -95,10 +95,4 @@ QdotModel* createJitModel(const kernel::KernelModule& k, const SourceManager& sm
   return m;
 }
 
-QdotModel* createJitModel(const kernel::KernelModule& k, const SourceManager& sm, int optLevel, std::string& error) {
-  JitOptions options;
-  options.optLevel = optLevel;
-  return createJitModel(k, sm, options, error);
-}
-
 }  // namespace qdot::llvmbackend

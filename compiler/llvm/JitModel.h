@@ -72,10 +72,16 @@ struct JitStats {
 /// `error` set. `sm` resolves source locations for lastError ("... in equation 3 at model.qd:9").
 /// The JIT session lives inside the model; destroy() releases it. Like the VM's models, one model
 /// must not be called from several threads at once (it owns scratch memory).
-QdotModel* createJitModel(const kernel::KernelModule& k, const SourceManager& sm, int optLevel, std::string& error);
-
-/// The same with every option, optionally reporting compile statistics.
+/// Fills `stats` if given.
 QdotModel* createJitModel(const kernel::KernelModule& k, const SourceManager& sm, const JitOptions& options,
                           std::string& error, JitStats* stats = nullptr);
+
+/// The options for one simulation (qdot run): the defaults, without the invariants unless the run
+/// asks for them.
+inline JitOptions jitOptionsForRun(bool invariants) {
+  JitOptions options;
+  if (!invariants) options.compiledPrograms &= ~programBit(kernel::ProgramId::Invariants);
+  return options;
+}
 
 }  // namespace qdot::llvmbackend
