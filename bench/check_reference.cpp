@@ -27,7 +27,6 @@
 namespace {
 
 using namespace qdot;
-using ModelPtr = std::unique_ptr<QdotModel, void (*)(QdotModel*)>;
 
 std::string readFile(const std::string& path) {
   std::ifstream in(path);
@@ -47,11 +46,9 @@ ModelPtr compileWithSize(const std::string& file, int n) {
     throw std::runtime_error("qdot could not compile " + file);
   }
   kernel::KernelModule kernels = kernel::buildKernels(*c.dae, c.ctx);
-  bc::Module module = bytecode::emitBytecode(kernels, c.sources);
-  std::string error;
-  QdotModel* model = vm::createModel(module, error);
-  if (!model) throw std::runtime_error(error);
-  return ModelPtr(model, model->destroy);
+  Result<ModelPtr> model = vm::createModel(bytecode::emitBytecode(kernels, c.sources));
+  if (!model) throw std::runtime_error(model.error());
+  return std::move(model).value();
 }
 
 /// Largest |a_i − b_i| / (1 + |b_i|).

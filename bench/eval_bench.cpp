@@ -37,7 +37,6 @@ struct State {
   std::vector<double> y, yp, p, F, J;
 };
 
-using ModelPtr = std::unique_ptr<QdotModel, void (*)(QdotModel*)>;
 
 template <bool Jacobian>
 void calls(const QdotModel* m, State& s, long n) {
@@ -121,7 +120,7 @@ int main(int argc, char** argv) {
   double lower = inf, codegen = inf;
   size_t instructions = 0, residualInstructions = 0;
   uint32_t functions = 0;
-  ModelPtr vmModel{nullptr, nullptr}, jitModel{nullptr, nullptr};
+  ModelPtr vmModel, jitModel;
   for (int r = 0; r < repeat; ++r) {
     vmModel.reset(), jitModel.reset();
     driver::Compilation c;
@@ -141,28 +140,26 @@ int main(int argc, char** argv) {
     }
     instructions = 0;
     for (const auto& p : kernels.programs) instructions += p.code.size();
-    residualInstructions = kernels.program(kernel::ProgramId::Residual).code.size();
-    std::string error;
+    residualInstructions = kernels.program(ModelProgram::Residual).code.size();
     t0 = Clock::now();
-    bc::Module module = bytecode::emitBytecode(kernels, c.sources);
-    QdotModel* vm = vm::createModel(module, error);
+    Result<ModelPtr> vm = vm::createModel(bytecode::emitBytecode(kernels, c.sources));
     bytecode = std::min(bytecode, secondsSince(t0));
     if (!vm) {
-      std::cerr << error << "\n";
+      std::cerr << vm.error() << "\n";
       return 1;
     }
-    vmModel = ModelPtr{vm, vm->destroy};
+    vmModel = std::move(vm).value();
     if (!noLlvm) {
       llvmbackend::JitStats stats;
       llvmbackend::JitOptions options;  // the defaults, as qdot run
       t0 = Clock::now();
-      QdotModel* jit = llvmbackend::createJitModel(kernels, c.sources, options, error, &stats);
+      Result<ModelPtr> jit = llvmbackend::createJitModel(kernels, c.sources, options, &stats);
       llvm = std::min(llvm, secondsSince(t0));
       if (!jit) {
-        std::cerr << error << "\n";
+        std::cerr << jit.error() << "\n";
         return 1;
       }
-      jitModel = ModelPtr{jit, jit->destroy};
+      jitModel = std::move(jit).value();
       lower = std::min(lower, stats.lowerSeconds + stats.optimiseSeconds), codegen = std::min(codegen, stats.codegenSeconds);
       functions = 0;
       for (uint32_t f : stats.functions) functions += f;

@@ -33,7 +33,7 @@ double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>
 
 /// The VM model of a file and the compile time in seconds (front end, kernels, bytecode).
 struct Compiled {
-  std::unique_ptr<QdotModel, void (*)(QdotModel*)> model{nullptr, nullptr};
+  ModelPtr model;
   rt::ExperimentDefaults experiment;
   double compileSeconds = 0;
   double kernelSeconds = 0, codegenSeconds = 0;  ///< the last two stages of compileSeconds
@@ -52,21 +52,17 @@ Compiled compile(const std::string& file, const std::string& backend, bool invar
   if (!kernels.errors.empty()) throw std::runtime_error(kernels.errors.front());
   out.kernelSeconds = secondsSince(t0);
   t0 = Clock::now();
-  std::string error;
-  QdotModel* model = nullptr;
+  Result<ModelPtr> model = Error{"built without the LLVM backend"};
   if (backend == "llvm") {
 #ifdef QDOT_BENCH_LLVM
-    model = llvmbackend::createJitModel(kernels, c.sources, llvmbackend::jitOptionsForRun(invariants), error);
-#else
-    throw std::runtime_error("built without the LLVM backend");
+    model = llvmbackend::createJitModel(kernels, c.sources, llvmbackend::jitOptionsForRun(invariants));
 #endif
   } else {
-    bc::Module module = bytecode::emitBytecode(kernels, c.sources);
-    model = vm::createModel(module, error);
+    model = vm::createModel(bytecode::emitBytecode(kernels, c.sources));
   }
-  if (!model) throw std::runtime_error(error);
+  if (!model) throw std::runtime_error(model.error());
   out.codegenSeconds = secondsSince(t0);
-  out.model = {model, model->destroy};
+  out.model = std::move(model).value();
   const auto& t = c.times;
   out.times = t;
   out.compileSeconds = t.parse + t.check + t.flatten + t.derive + t.dae + out.kernelSeconds + out.codegenSeconds;

@@ -11,25 +11,13 @@ namespace {
 
 constexpr uint32_t kUnused = UINT32_MAX;
 
-// Kernel and bytecode number opcodes and functions the same way (both come from one list).
+// Kernel and bytecode number opcodes the same way (both come from qdot/opcodes.def).
 static_assert(static_cast<int>(kernel::Op::Store) == static_cast<int>(bc::Opcode::Store));
-static_assert(kernel::kProgramCount == bc::kFunctionCount);
-static_assert(static_cast<int>(kernel::ProgramId::Invariants) == static_cast<int>(bc::FunctionId::Invariants));
-static_assert(static_cast<int>(kernel::ProgramId::Jacobian) == static_cast<int>(bc::FunctionId::Jacobian));
 
-// The registers an instruction reads (by format), at most three.
+// The registers an instruction reads (a, b, c: as many as its format reads).
 uint32_t operandsOf(const kernel::Instr& ins, uint32_t out[3]) {
-  switch (bc::info(static_cast<bc::Opcode>(ins.op)).format) {
-    case bc::Format::End:
-    case bc::Format::None:
-    case bc::Format::Index: return 0;
-    case bc::Format::Unary:
-    case bc::Format::UnaryIndex:
-    case bc::Format::Store: return out[0] = ins.a, 1;
-    case bc::Format::Binary: return out[0] = ins.a, out[1] = ins.b, 2;
-    case bc::Format::Ternary: return out[0] = ins.a, out[1] = ins.b, out[2] = ins.c, 3;
-  }
-  return 0;
+  out[0] = ins.a, out[1] = ins.b, out[2] = ins.c;
+  return bc::readCount(bc::info(static_cast<bc::Opcode>(ins.op)).format);
 }
 
 class Allocator {
@@ -100,17 +88,8 @@ bc::Function emitFunction(const kernel::Program& p) { return Allocator(p).run();
 
 bc::Module emitBytecode(const kernel::KernelModule& k, const SourceManager& sm) {
   bc::Module m;
-  m.name = k.name;
-  m.variableNames = k.variableNames;
-  m.parameterNames = k.parameterNames;
-  m.parameterDescriptions = k.parameterDescriptions;
-  m.outputNames = k.outputNames;
-  m.invariantNames = k.invariantNames;
-  m.isDifferential = k.isDifferential;
-  m.fixed = k.fixed;
-  m.jacobianColumnStarts = k.jacobianColumnStarts;
-  m.jacobianRowIndices = k.jacobianRowIndices;
-  for (size_t f = 0; f < kernel::kProgramCount; ++f) m.functions[f] = emitFunction(k.programs[f]);
+  m.description = k.description;
+  for (size_t f = 0; f < kModelProgramCount; ++f) m.functions[f] = emitFunction(k.programs[f]);
   for (const kernel::Source& s : k.sources)
     m.locations.push_back({s.label, kernel::describeLocation(sm, s.range), s.text});
   return m;

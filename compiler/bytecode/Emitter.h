@@ -10,8 +10,7 @@
 
 namespace qdot::bytecode {
 
-/// Every program of the kernel module, with names, sizes, the Jacobian pattern and the source
-/// table (labels and "file.qd:line" resolved with `sm`). The result passes bc::validate.
+/// Every program of the kernel module, its description (copied) and the source table (labels and "file.qd:line" resolved with `sm`). The result passes bc::validate.
 bc::Module emitBytecode(const kernel::KernelModule& k, const SourceManager& sm);
 
 /// One program. Instruction sources are the kernel's source indices (= Module::locations indices).

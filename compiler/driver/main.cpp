@@ -120,13 +120,17 @@ struct CompiledModel {
 CompiledModel compileModel(const kernel::KernelModule& kernels, const SourceManager& sources, const Options& o) {
   CompiledModel out;
   if (o.backend == "llvm" && o.jitWait) {
-    out.model = llvmbackend::createJitModel(kernels, sources, llvmbackend::jitOptionsForRun(o.run.invariants), out.jit->error, &out.jit->stats);
+    Result<ModelPtr> jit = llvmbackend::createJitModel(kernels, sources, llvmbackend::jitOptionsForRun(o.run.invariants), &out.jit->stats);
+    if (jit) out.model = jit->release();
+    else out.jit->error = jit.error();
     out.what = "llvm";
     out.waited = true;
     if (out.model) return out;
     std::cerr << "qdot: warning: the LLVM JIT failed (" << out.jit->error << "); running on the bytecode VM instead\n";
   }
-  QdotModel* vmModel = vm::createModel(bytecode::emitBytecode(kernels, sources), out.error);
+  Result<ModelPtr> created = vm::createModel(bytecode::emitBytecode(kernels, sources));
+  if (!created) out.error = created.error();
+  QdotModel* vmModel = created ? created->release() : nullptr;
   out.what = "bytecode";
   out.waited = false;
   if (!vmModel || o.backend != "llvm" || o.jitWait) {
@@ -136,11 +140,13 @@ CompiledModel compileModel(const kernel::KernelModule& kernels, const SourceMana
   llvmbackend::JitOptions options = llvmbackend::jitOptionsForRun(o.run.invariants);
   options.threads = std::max(2u, std::thread::hardware_concurrency()) - 1;  // one core keeps solving
   out.what = "bytecode then llvm";
-  out.model = rt::createTieredModel(vmModel, [&kernels, &sources, options, jit = out.jit](const std::atomic<bool>& cancel) {
+  out.model = rt::createTieredModel(ModelPtr(vmModel), [&kernels, &sources, options, jit = out.jit](const std::atomic<bool>& cancel) {
     llvmbackend::JitOptions withCancel = options;
     withCancel.cancel = &cancel;
-    return llvmbackend::createJitModel(kernels, sources, withCancel, jit->error, &jit->stats);
-  });
+    Result<ModelPtr> jitModel = llvmbackend::createJitModel(kernels, sources, withCancel, &jit->stats);
+    if (!jitModel) jit->error = jitModel.error();
+    return jitModel ? std::move(jitModel).value() : ModelPtr();
+  }).release();
   return out;
 }
 
@@ -273,13 +279,11 @@ int runBuild(const Options& o) {
   bc::Module module = bytecode::emitBytecode(kernels, c.sources);
   std::vector<uint8_t> bytes = bc::serialize(module);
   {  // the bytes must load exactly as the executable will load them
-    std::string error;
-    QdotModel* model = vm::createModelFromBytes(bytes, error);
+    Result<ModelPtr> model = vm::createModelFromBytes(bytes);
     if (!model) {
-      std::cerr << "qdot: internal error: " << error << "\n";
+      std::cerr << "qdot: internal error: " << model.error() << "\n";
       return 1;
     }
-    model->destroy(model);
   }
   c.diags.render(std::cerr, c.sources, isatty(2));  // warnings, if any
 
@@ -293,13 +297,13 @@ int runBuild(const Options& o) {
   fs::path source = dir / "model.cpp";
   fs::path object = dir / "model.o";
   int code = 0;
-  llvmbackend::ObjectFileInfo native;
-  std::string error;
   bool llvm = o.buildBackend == "llvm";
-  if (llvm && !llvmbackend::emitObjectFile(kernels, 2, object.string(), native, error)) {
-    std::cerr << "qdot: internal error: " << error << "\n";
+  Result<llvmbackend::ObjectFileInfo> native =
+      llvm ? llvmbackend::emitObjectFile(kernels, 2, object.string()) : llvmbackend::ObjectFileInfo{};
+  if (!native) {
+    std::cerr << "qdot: internal error: " << native.error() << "\n";
     code = 1;
-  } else if (!writeModelSource(source, bytes, *c.dae, llvm ? &native : nullptr)) {
+  } else if (!writeModelSource(source, bytes, *c.dae, llvm ? &native.value() : nullptr)) {
     std::cerr << "qdot: error: cannot write " << source << "\n";
     code = 1;
   } else {

@@ -16,12 +16,12 @@ namespace qdot::kernel {
 #define QDOT_KERNEL_UnaryIndex(E) r[i] = (E);
 #define QDOT_KERNEL_Store(E) out[I] = (E);
 
-void interpret(const Program& prog, const Inputs& in, std::span<double> out) {
+void interpret(const Program& prog, const ModelCall& in, std::span<double> out) {
   std::vector<double> r(prog.code.size(), 0.0);
   const double t = in.t, cj = in.cj;
-  const double *y = in.y.data(), *yp = in.yp.data(), *p = in.p.data(), *given = in.given.data();
+  const double *y = in.y, *yp = in.yp, *p = in.p, *given = in.given;
   const double* k = prog.constants.data();
-  const uint8_t* overridden = in.overridden.data();
+  const uint8_t* overridden = in.overridden;
   for (size_t i = 0; i < prog.code.size(); ++i) {
     const Instr& ins = prog.code[i];
     const double A = r[ins.a], B = r[ins.b], C = r[ins.c];

@@ -4,7 +4,6 @@
 // runtime/include/qdot/opcodes.def; every instruction names the equation (source) it serves.
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <iosfwd>
 #include <span>
@@ -12,6 +11,8 @@
 #include <vector>
 
 #include "dae/Dae.h"
+#include "qdot/model_description.hpp"
+#include "qdot/programs.hpp"
 #include "support/SourceManager.h"
 #include "symbolic/Expr.h"
 
@@ -24,6 +25,8 @@ enum class Op : uint8_t {
 };
 /// The opcode's spelling in qdot/opcodes.def ("add", "ldy", ...).
 const char* mnemonic(Op op);
+/// How many of the operands a, b, c the opcode reads (its format's arity, qdot/bytecode.h).
+uint32_t readCount(Op op);
 
 /// One instruction. Instruction i of a program defines virtual register %i (SSA); `Store` and
 /// `Ret` define nothing. Operands a, b, c are earlier registers; `imm` is the input index for loads,
@@ -50,27 +53,19 @@ struct Source {
   std::string text;   ///< the equation as written, shortened ("" if none)
 };
 
-/// The programs of a module, in model-ABI order (the same order as qdot::bc::FunctionId).
-enum class ProgramId : uint8_t { Parameters, InitialValues, Residual, Jacobian, Outputs, Invariants };
-inline constexpr size_t kProgramCount = 6;
-
 /// Everything a backend needs to implement the model ABI.
 struct KernelModule {
-  std::string name;
-  std::vector<std::string> variableNames, parameterNames, parameterDescriptions, outputNames, invariantNames;
-  std::vector<int32_t> isDifferential;  ///< [nVariables]
-  std::vector<int32_t> fixed;           ///< [nVariables]
-  std::vector<int32_t> jacobianColumnStarts, jacobianRowIndices;  ///< CSC; column j = variable j
+  ModelDescription description;  ///< names, flags, Jacobian pattern (carried on by every backend)
   /// parameters: out[i] = p_i. initialValues: out = [y0 (n), yp0 (n), nominal (n)].
   /// residual: out = F (n). jacobian: out = values in CSC order. outputs, invariants: one each.
-  std::array<Program, kProgramCount> programs;
+  PerProgram<Program> programs;
   std::vector<Source> sources;
   size_t sharedTemporaries = 0;     ///< CSE temporaries of residual + Jacobian together
   std::vector<std::string> errors;  ///< constructs not supported yet (e.g. implicit initial equations)
 
-  Program& program(ProgramId id) { return programs[static_cast<uint8_t>(id)]; }
-  const Program& program(ProgramId id) const { return programs[static_cast<uint8_t>(id)]; }
-  size_t variableCount() const { return variableNames.size(); }
+  Program& program(ModelProgram p) { return programs[programIndex(p)]; }
+  const Program& program(ModelProgram p) const { return programs[programIndex(p)]; }
+  size_t variableCount() const { return description.variableCount(); }
 };
 
 /// Builds every program of the model. `ctx` must be the Context the Dae's expressions live in
@@ -86,15 +81,8 @@ void printProgram(std::ostream& os, const Program& p, const KernelModule& m);
 /// "file.qd:12" for a range, "" if it has no location.
 std::string describeLocation(const SourceManager& sm, SourceRange r);
 
-/// The inputs a program may read (unused ones may be empty).
-struct Inputs {
-  double t = 0, cj = 0;
-  std::span<const double> y, yp, p, given;
-  std::span<const uint8_t> overridden;
-};
-
 /// Reference interpreter of the kernel IR (tests and debugging; the VM is the fast path).
 /// out.size() must be >= p.outputCount.
-void interpret(const Program& p, const Inputs& in, std::span<double> out);
+void interpret(const Program& p, const ModelCall& in, std::span<double> out);
 
 }  // namespace qdot::kernel

@@ -30,8 +30,8 @@ class Builder {
     buildParameters();
     buildInitialValues();
     buildResidualAndJacobian();
-    m_.program(ProgramId::Outputs) = buildOutputs();
-    m_.program(ProgramId::Invariants) = buildInvariants();
+    m_.program(ModelProgram::Outputs) = buildOutputs();
+    m_.program(ModelProgram::Invariants) = buildInvariants();
     return std::move(m_);
   }
 
@@ -48,18 +48,19 @@ class Builder {
   }
 
   void describeModel() {
-    m_.name = dae_.name;
+    ModelDescription& d = m_.description;
+    d.name = dae_.name;
     for (const auto& v : dae_.variables) {
-      m_.variableNames.push_back(v.name);
-      m_.isDifferential.push_back(v.kind == dae::VarKind::State);
-      m_.fixed.push_back(defaultFixed(v));
+      d.variableNames.push_back(v.name);
+      d.isDifferential.push_back(v.kind == dae::VarKind::State);
+      d.fixed.push_back(defaultFixed(v));
     }
     for (const auto& p : dae_.parameters) {
-      m_.parameterNames.push_back(p.name);
-      m_.parameterDescriptions.push_back(p.description);
+      d.parameterNames.push_back(p.name);
+      d.parameterDescriptions.push_back(p.description);
     }
-    for (const auto& o : dae_.outputs) m_.outputNames.push_back(o.name);
-    for (const auto& inv : dae_.invariants) m_.invariantNames.push_back(inv.name);
+    for (const auto& o : dae_.outputs) d.outputNames.push_back(o.name);
+    for (const auto& inv : dae_.invariants) d.invariantNames.push_back(inv.name);
   }
 
   // Coordinates and velocities that are states start fixed; another state is fixed if it has a
@@ -180,7 +181,7 @@ class Builder {
       b.store(k, value);
     }
     reportUnbound(b, "parameter bindings");
-    m_.program(ProgramId::Parameters) = b.finish(static_cast<uint32_t>(dae_.parameters.size()));
+    m_.program(ModelProgram::Parameters) = b.finish(static_cast<uint32_t>(dae_.parameters.size()));
   }
 
   // --- start values ----------------------------------------------------------------------------
@@ -210,7 +211,7 @@ class Builder {
         const auto& v = dae_.variables[j];
         if (v.y != target && v.yp != target) continue;
         uint32_t src = addSource("initial equation " + std::to_string(i + 1), e.origin.range, equationText(e));
-        if (v.y == target) starts[j].y0 = value, starts[j].source = src, m_.fixed[j] = 1;
+        if (v.y == target) starts[j].y0 = value, starts[j].source = src, m_.description.fixed[j] = 1;
         else starts[j].yp0 = value, starts[j].derivativeSource = src;
         return true;
       }
@@ -251,7 +252,7 @@ class Builder {
       store(2 * n + j, v.nominal, v.nominal ? addSource("nominal value of " + v.name, v.declRange) : UINT32_MAX);
     }
     reportUnbound(b, "start values (only parameters may be used)");
-    m_.program(ProgramId::InitialValues) = b.finish(3 * n);
+    m_.program(ModelProgram::InitialValues) = b.finish(3 * n);
   }
 
   // --- residual and Jacobian ---------------------------------------------------------------------
@@ -259,8 +260,8 @@ class Builder {
   void buildResidualAndJacobian() {
     Expr cj = ctx_.symbol("$cj");
     JacobianEntries jac = differentiate(dae_, ctx_, cj);
-    m_.jacobianColumnStarts = jac.columnStarts;
-    m_.jacobianRowIndices = jac.rowIndices;
+    m_.description.jacobianColumnStarts = jac.columnStarts;
+    m_.description.jacobianRowIndices = jac.rowIndices;
     std::vector<Expr> roots;
     for (const auto& e : dae_.equations) roots.push_back(e.residual);
     roots.insert(roots.end(), jac.values.begin(), jac.values.end());
@@ -273,7 +274,7 @@ class Builder {
     for (const auto& [t, value] : cse.temporaries) res.bindTemporary(t, value);
     for (uint32_t i = 0; i < n; ++i) res.setSource(equationSource_[i]), res.store(i, res.lower(cse.outputs[i]));
     reportUnbound(res, "residual");
-    m_.program(ProgramId::Residual) = res.finish(static_cast<uint32_t>(n));
+    m_.program(ModelProgram::Residual) = res.finish(static_cast<uint32_t>(n));
 
     ProgramBuilder jb("jacobian");
     bindInputs(jb, true, cj);
@@ -282,7 +283,7 @@ class Builder {
       jb.setSource(equationSource_[jac.rowIndices[k]]);
       jb.store(k, jb.lower(cse.outputs[n + k]));
     }
-    m_.program(ProgramId::Jacobian) = jb.finish(static_cast<uint32_t>(jac.values.size()));
+    m_.program(ModelProgram::Jacobian) = jb.finish(static_cast<uint32_t>(jac.values.size()));
   }
 
   // --- outputs and invariants --------------------------------------------------------------------

@@ -24,10 +24,10 @@ std::string join(const std::vector<std::string>& names) {
 const std::vector<std::string>* namesOfLoad(Op op, const KernelModule& m) {
   switch (op) {
     case Op::LoadY:
-    case Op::LoadYp: return &m.variableNames;
+    case Op::LoadYp: return &m.description.variableNames;
     case Op::LoadP:
     case Op::LoadGiven:
-    case Op::LoadOverridden: return &m.parameterNames;
+    case Op::LoadOverridden: return &m.description.parameterNames;
     default: return nullptr;
   }
 }
@@ -52,20 +52,21 @@ std::string operands(const Instr& ins, const Program& prog, const KernelModule& 
 }
 
 void printHeader(std::ostream& os, const KernelModule& m) {
-  os << "kernel " << m.name << "\n";
+  const ModelDescription& d = m.description;
+  os << "kernel " << d.name << "\n";
   os << "variables (" << m.variableCount() << "):";
   for (size_t j = 0; j < m.variableCount(); ++j)
-    os << (j ? ", " : " ") << m.variableNames[j] << (m.isDifferential[j] ? " [differential" : " [algebraic")
-       << (m.fixed[j] ? ", fixed]" : "]");
-  os << "\nparameters (" << m.parameterNames.size() << "): " << join(m.parameterNames) << "\n";
-  os << "outputs (" << m.outputNames.size() << "): " << join(m.outputNames) << "\n";
-  os << "invariants (" << m.invariantNames.size() << "): " << join(m.invariantNames) << "\n";
-  os << "jacobian (CSC, " << m.jacobianRowIndices.size() << " nonzeros, " << m.sharedTemporaries
+    os << (j ? ", " : " ") << d.variableNames[j] << (d.isDifferential[j] ? " [differential" : " [algebraic")
+       << (d.fixed[j] ? ", fixed]" : "]");
+  os << "\nparameters (" << d.parameterNames.size() << "): " << join(d.parameterNames) << "\n";
+  os << "outputs (" << d.outputNames.size() << "): " << join(d.outputNames) << "\n";
+  os << "invariants (" << d.invariantNames.size() << "): " << join(d.invariantNames) << "\n";
+  os << "jacobian (CSC, " << d.jacobianRowIndices.size() << " nonzeros, " << m.sharedTemporaries
      << " CSE temporaries shared with the residual):\n";
   for (size_t j = 0; j < m.variableCount(); ++j) {
-    os << "  column " << j << " (" << m.variableNames[j] << "): rows";
-    for (int32_t k = m.jacobianColumnStarts[j]; k < m.jacobianColumnStarts[j + 1]; ++k)
-      os << " " << m.jacobianRowIndices[k];
+    os << "  column " << j << " (" << d.variableNames[j] << "): rows";
+    for (int32_t k = d.jacobianColumnStarts[j]; k < d.jacobianColumnStarts[j + 1]; ++k)
+      os << " " << d.jacobianRowIndices[k];
     os << "\n";
   }
   for (const auto& e : m.errors) os << "unsupported: " << e << "\n";
@@ -74,6 +75,7 @@ void printHeader(std::ostream& os, const KernelModule& m) {
 }  // namespace
 
 const char* mnemonic(Op op) { return bc::info(static_cast<bc::Opcode>(op)).mnemonic; }
+uint32_t readCount(Op op) { return bc::readCount(bc::info(static_cast<bc::Opcode>(op)).format); }
 
 std::string describeLocation(const SourceManager& sm, SourceRange r) {
   if (!r.valid()) return "";

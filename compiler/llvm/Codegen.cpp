@@ -25,35 +25,6 @@ namespace {
 using kernel::Instr;
 using kernel::Op;
 
-/// Number of register operands (a, b, c) an opcode reads.
-unsigned operandCount(Op op) {
-  switch (op) {
-#define QDOT_ARITY_End 0
-#define QDOT_ARITY_None 0
-#define QDOT_ARITY_Index 0
-#define QDOT_ARITY_Unary 1
-#define QDOT_ARITY_Binary 2
-#define QDOT_ARITY_Ternary 3
-#define QDOT_ARITY_UnaryIndex 1
-#define QDOT_ARITY_Store 1
-#define QDOT_OPCODE(Name, Mnemonic, Format, Value) \
-  case Op::Name: return QDOT_ARITY_##Format;
-#include "qdot/opcodes.def"
-  }
-  return 0;
-}
-
-/// Loads and constants: cheaper to redo in a later function than to pass through the spill array.
-bool rematerialisable(Op op) {
-  switch (op) {
-    case Op::LoadTime: case Op::LoadCj: case Op::LoadY: case Op::LoadYp: case Op::LoadP:
-    case Op::LoadGiven: case Op::LoadOverridden: case Op::LoadConst: return true;
-    default: return false;
-  }
-}
-
-uint32_t operand(const Instr& ins, unsigned i) { return i == 0 ? ins.a : i == 1 ? ins.b : ins.c; }
-
 /// The arguments of every generated function, in ProgramFn order.
 enum Arg : unsigned { kTimeCj, kY, kYp, kP, kGiven, kOverridden, kOut, kSpill, kArgCount };
 
@@ -227,26 +198,6 @@ void emitCaller(llvm::Function* entry, const std::vector<llvm::Function*>& parts
 
 }  // namespace
 
-ProgramSplit splitProgram(const kernel::Program& p, uint32_t maxInstructions) {
-  ProgramSplit s;
-  size_t n = p.code.size();
-  s.chunk = std::max<uint32_t>(1, maxInstructions);
-  s.parts = static_cast<uint32_t>(std::max<size_t>(1, (n + s.chunk - 1) / s.chunk));
-  s.spillSlot.assign(n, ProgramSplit::kNoSlot);
-  auto partOf = [&](size_t i) { return i / s.chunk; };
-  for (size_t i = 0; i < n; ++i) {
-    const Instr& ins = p.code[i];
-    for (unsigned j = 0, e = operandCount(ins.op); j < e; ++j) {
-      uint32_t v = operand(ins, j);
-      if (partOf(v) != partOf(i) && !rematerialisable(p.code[v].op) && s.spillSlot[v] == ProgramSplit::kNoSlot)
-        s.spillSlot[v] = s.spillSlots++;
-    }
-  }
-  return s;
-}
-
-std::string partName(const std::string& name, uint32_t k) { return name + "." + std::to_string(k); }
-
 void lowerParts(const kernel::Program& p, const ProgramSplit& split, uint32_t first, uint32_t last,
                 const std::string& name, llvm::Module& m, bool internal) {
   for (uint32_t k = first; k < last; ++k) {
@@ -256,15 +207,11 @@ void lowerParts(const kernel::Program& p, const ProgramSplit& split, uint32_t fi
   }
 }
 
-std::string entryName(const kernel::Program& p, kernel::ProgramId id) {
-  return "qdot_" + (p.name.empty() ? std::to_string(static_cast<int>(id)) : p.name);
-}
-
 LoweredModule lowerKernels(const kernel::KernelModule& k, llvm::LLVMContext& ctx, uint32_t maxInstructions) {
   LoweredModule out;
-  out.module = std::make_unique<llvm::Module>("qdot." + k.name, ctx);
-  for (size_t i = 0; i < kernel::kProgramCount; ++i) {
-    auto id = static_cast<kernel::ProgramId>(i);
+  out.module = std::make_unique<llvm::Module>("qdot." + k.description.name, ctx);
+  for (size_t i = 0; i < kModelProgramCount; ++i) {
+    ModelProgram id = programAt(i);
     const kernel::Program& prog = k.program(id);
     const std::string name = entryName(prog, id);
     ProgramSplit split = splitProgram(prog, maxInstructions);

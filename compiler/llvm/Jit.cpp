@@ -1,5 +1,5 @@
-// JIT session: the programs to compile are cut into compile units (consecutive parts of one
-// program at one code generator level), each lowered into its own LLVMContext and module and
+// JIT session: the compile plan (CompilePlan.h) cuts the programs into compile units (consecutive
+// parts of programs at one code generator level), each lowered into its own LLVMContext and module and
 // compiled to an object in memory by a pool of threads; LLJIT then links the objects in-process
 // and hands out the part functions. Separate contexts and target machines per thread make the
 // units independent, so compile time divides by the number of cores on large models; small ones
@@ -27,6 +27,7 @@
 #include <llvm/Target/TargetMachine.h>
 
 #include "llvm/Codegen.h"
+#include "llvm/CompilePlan.h"
 
 namespace qdot::llvmbackend {
 
@@ -40,7 +41,6 @@ JitSession::~JitSession() = default;
 namespace {
 
 using Clock = std::chrono::steady_clock;
-using kernel::ProgramId;
 double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 void initialiseNativeTarget() {
@@ -91,84 +91,23 @@ bool take(llvm::Expected<T>& value, std::string& error, const char* what) {
   return false;
 }
 
-/// One compiled program: how it is split and at which level its units are compiled.
-struct ProgramPlan {
-  bool compiled = false;
-  std::string name;  // "qdot_residual"; part k is partName(name, k)
-  ProgramSplit split;
-  int level = 0;
-};
-
-/// Consecutive parts [first, last) of one program.
-struct Segment {
-  ProgramId program{};
-  uint32_t first = 0, last = 0;
-};
-
-/// Segments compiled at one level into one module and one object.
+/// A planned unit being compiled: its object, or why not, and what each phase cost.
 struct CompileUnit {
-  int level = 0;
-  std::vector<Segment> segments;
-  size_t instructions = 0;
+  PlannedUnit plan;
   std::unique_ptr<llvm::MemoryBuffer> object;
   std::string error;
   double lower = 0, optimise = 0, codegen = 0;
 };
-
-int levelOf(ProgramId id, const JitOptions& o) {
-  if (id == ProgramId::Residual) return o.optLevel;
-  if (id == ProgramId::Jacobian) return o.jacobianOptLevel >= 0 ? o.jacobianOptLevel : o.optLevel;
-  return o.coldOptLevel;
-}
 
 unsigned threadCount(const JitOptions& o) {
   unsigned hw = std::max(1u, std::thread::hardware_concurrency());
   return o.threads ? o.threads : std::min(hw, 8u);
 }
 
-// Splits each compiled program and groups parts of the same level into units of about `budget`
-// instructions: big enough that the per-module cost (a pass pipeline, an object to link) stays
-// small (a small model is one unit per level), small enough that `threads` threads share the
-// work evenly (about two units per thread on a large model).
-std::vector<CompileUnit> planUnits(const kernel::KernelModule& k, const JitOptions& o, unsigned threads,
-                                   std::array<ProgramPlan, kernel::kProgramCount>& plans) {
-  size_t total = 0;
-  for (size_t i = 0; i < kernel::kProgramCount; ++i)
-    if (o.compiledPrograms & programBit(static_cast<ProgramId>(i))) total += k.programs[i].code.size();
-  bool large = total > o.largeModelInstructions;
-  // At most 100 000 instructions (~0.1 s at level 0): a cancelled compile stops within a unit.
-  size_t budget = std::min<size_t>(std::max<size_t>(size_t{4} * o.maxInstructionsPerFunction, total / (2 * threads)),
-                                   std::max<size_t>(100000, o.maxInstructionsPerFunction));
-  std::vector<CompileUnit> units;
-  std::map<int, size_t> filling;  // level -> index of the unit being filled at that level
-  for (size_t i = 0; i < kernel::kProgramCount; ++i) {
-    auto id = static_cast<ProgramId>(i);
-    if (!(o.compiledPrograms & programBit(id))) continue;
-    const kernel::Program& prog = k.programs[i];
-    ProgramPlan& plan = plans[i];
-    plan.compiled = true;
-    plan.name = entryName(prog, id);
-    plan.split = splitProgram(prog, o.maxInstructionsPerFunction);
-    plan.level = large ? 0 : levelOf(id, o);
-    for (uint32_t part = 0; part < plan.split.parts; ++part) {
-      auto it = filling.find(plan.level);
-      if (it == filling.end() || units[it->second].instructions >= budget) {
-        units.push_back(CompileUnit{plan.level});
-        it = filling.insert_or_assign(plan.level, units.size() - 1).first;
-      }
-      CompileUnit& u = units[it->second];
-      if (u.segments.empty() || u.segments.back().program != id) u.segments.push_back({id, part, part});
-      u.segments.back().last = part + 1;
-      u.instructions += plan.split.end(part, prog.code.size()) - plan.split.begin(part);
-    }
-  }
-  return units;
-}
-
 /// Compiles units to objects; one per thread (target machines are not shared between threads).
 class UnitCompiler {
  public:
-  UnitCompiler(const kernel::KernelModule& k, const std::array<ProgramPlan, kernel::kProgramCount>& plans,
+  UnitCompiler(const kernel::KernelModule& k, const PerProgram<ProgramPlan>& plans,
                const llvm::orc::JITTargetMachineBuilder& host, const JitOptions& o)
       : k_(k), plans_(plans), host_(host), pipelineLevel_(o.pipelineLevel), verify_(o.verifyIR), cancel_(o.cancel) {}
 
@@ -177,16 +116,16 @@ class UnitCompiler {
       u.error = "cancelled";
       return;
     }
-    llvm::TargetMachine* tm = machine(u.level, u.error);
+    llvm::TargetMachine* tm = machine(u.plan.level, u.error);
     if (!tm) return;
     auto start = Clock::now();
     llvm::LLVMContext ctx;
-    const Segment& head = u.segments.front();
-    llvm::Module m(partName(plans_[static_cast<size_t>(head.program)].name, head.first), ctx);
+    const Segment& head = u.plan.segments.front();
+    llvm::Module m(partName(plans_[programIndex(head.program)].name, head.first), ctx);
     m.setDataLayout(tm->createDataLayout());
     m.setTargetTriple(tm->getTargetTriple().str());
-    for (const Segment& s : u.segments) {
-      const ProgramPlan& plan = plans_[static_cast<size_t>(s.program)];
+    for (const Segment& s : u.plan.segments) {
+      const ProgramPlan& plan = plans_[programIndex(s.program)];
       lowerParts(k_.program(s.program), plan.split, s.first, s.last, plan.name, m, false);
     }
     std::string verifyErrors;
@@ -197,7 +136,7 @@ class UnitCompiler {
     }
     u.lower = secondsSince(start);
     start = Clock::now();
-    optimise(m, tm, pipelineLevel_ >= 0 ? pipelineLevel_ : u.level);
+    optimise(m, tm, pipelineLevel_ >= 0 ? pipelineLevel_ : u.plan.level);
     u.optimise = secondsSince(start);
     start = Clock::now();
     llvm::SmallVector<char, 0> buffer;
@@ -226,7 +165,7 @@ class UnitCompiler {
   }
 
   const kernel::KernelModule& k_;
-  const std::array<ProgramPlan, kernel::kProgramCount>& plans_;
+  const PerProgram<ProgramPlan>& plans_;
   const llvm::orc::JITTargetMachineBuilder& host_;
   int pipelineLevel_;
   bool verify_;
@@ -241,7 +180,7 @@ void compileAll(std::vector<CompileUnit>& units, unsigned threads, Compile makeC
   std::vector<size_t> order(units.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(),
-                   [&](size_t a, size_t b) { return units[a].instructions > units[b].instructions; });
+                   [&](size_t a, size_t b) { return units[a].plan.instructions > units[b].plan.instructions; });
   std::atomic<size_t> next{0};
   auto worker = [&] {
     UnitCompiler c = makeCompiler();
@@ -256,19 +195,22 @@ void compileAll(std::vector<CompileUnit>& units, unsigned threads, Compile makeC
 
 }  // namespace
 
-std::unique_ptr<JitSession> JitSession::compile(const kernel::KernelModule& k, const JitOptions& options,
-                                                std::string& error, JitStats* stats) {
+Result<std::unique_ptr<JitSession>> JitSession::compile(const kernel::KernelModule& k, const JitOptions& options,
+                                                        JitStats* stats) {
+  std::string error;
   auto wallStart = Clock::now();
   initialiseNativeTarget();
   JitStats local;
   JitStats& st = stats ? *stats : local;
   auto host = llvm::orc::JITTargetMachineBuilder::detectHost();
-  if (!take(host, error, "LLVM cannot target this host")) return nullptr;
+  if (!take(host, error, "LLVM cannot target this host")) return Error{error};
   host->setRelocationModel(llvm::Reloc::PIC_);
 
   unsigned threads = threadCount(options);
-  std::array<ProgramPlan, kernel::kProgramCount> plans;
-  std::vector<CompileUnit> units = planUnits(k, options, threads, plans);
+  CompilePlan plan = planCompile(k, options, threads);
+  const PerProgram<ProgramPlan>& plans = plan.programs;
+  std::vector<CompileUnit> units;
+  for (PlannedUnit& u : plan.units) units.push_back(CompileUnit{std::move(u)});
 
   // The JIT itself is created while the workers compile.
   std::unique_ptr<llvm::orc::LLJIT> jit;
@@ -281,39 +223,33 @@ std::unique_ptr<JitSession> JitSession::compile(const kernel::KernelModule& k, c
         if (take(created, error, "cannot create the LLVM JIT")) jit = std::move(*created);
         createSeconds = secondsSince(start);
       });
-  if (!jit) return nullptr;
+  if (!jit) return Error{error};
   for (const CompileUnit& u : units)
-    if (!u.error.empty()) {
-      error = u.error;
-      return nullptr;
-    }
+    if (!u.error.empty()) return Error{u.error};
 
   auto start = Clock::now();
   auto& dylib = jit->getMainJITDylib();
   auto process = llvm::orc::DynamicLibrarySearchGenerator::GetForCurrentProcess(jit->getDataLayout().getGlobalPrefix());
-  if (!take(process, error, "cannot resolve libm symbols")) return nullptr;
+  if (!take(process, error, "cannot resolve libm symbols")) return Error{error};
   dylib.addGenerator(std::move(*process));
   for (CompileUnit& u : units)
-    if (auto err = jit->addObjectFile(std::move(u.object))) {
-      error = "LLVM JIT: " + llvm::toString(std::move(err));
-      return nullptr;
-    }
+    if (auto err = jit->addObjectFile(std::move(u.object))) return Error{"LLVM JIT: " + llvm::toString(std::move(err))};
   llvm::orc::SymbolLookupSet names;
   for (const ProgramPlan& plan : plans)
     for (uint32_t p = 0; plan.compiled && p < plan.split.parts; ++p) names.add(jit->mangleAndIntern(partName(plan.name, p)));
   auto symbols = jit->getExecutionSession().lookup(llvm::orc::makeJITDylibSearchOrder({&dylib}), std::move(names));
-  if (!take(symbols, error, "LLVM JIT lookup")) return nullptr;
+  if (!take(symbols, error, "LLVM JIT lookup")) return Error{error};
 
   std::unique_ptr<JitSession> session(new JitSession());
-  for (size_t i = 0; i < kernel::kProgramCount; ++i) {
-    const ProgramPlan& plan = plans[i];
-    for (uint32_t p = 0; plan.compiled && p < plan.split.parts; ++p) {
-      auto address = (*symbols)[jit->mangleAndIntern(partName(plan.name, p))].getAddress();
+  for (size_t i = 0; i < kModelProgramCount; ++i) {
+    const ProgramPlan& p = plans[i];
+    for (uint32_t part = 0; p.compiled && part < p.split.parts; ++part) {
+      auto address = (*symbols)[jit->mangleAndIntern(partName(p.name, part))].getAddress();
       session->parts_[i].push_back(reinterpret_cast<ProgramFn>(static_cast<uintptr_t>(address)));
     }
-    session->spill_[i] = plan.split.spillSlots;
-    st.functions[i] = plan.compiled ? plan.split.parts : 0;
-    st.spillSlots[i] = plan.split.spillSlots;
+    session->spill_[i] = p.split.spillSlots;
+    st.functions[i] = p.compiled ? p.split.parts : 0;
+    st.spillSlots[i] = p.split.spillSlots;
   }
   session->impl_->jit = std::move(jit);
   for (const CompileUnit& u : units) st.lowerSeconds += u.lower, st.optimiseSeconds += u.optimise, st.codegenSeconds += u.codegen;

@@ -4,7 +4,6 @@
 // No LLVM type in this header, so JitModel.cpp's ABI code stays plain C++.
 #pragma once
 
-#include <array>
 #include <memory>
 #include <span>
 #include <string>
@@ -24,25 +23,25 @@ using ProgramFn = void (*)(const double* tcj, const double* y, const double* yp,
 /// Compiled code of every program; owns the LLJIT instance (and so the machine code).
 class JitSession {
  public:
-  /// Compiles `k`; nullptr with `error` on failure. Fills `stats` if given.
-  static std::unique_ptr<JitSession> compile(const kernel::KernelModule& k, const JitOptions& options,
-                                             std::string& error, JitStats* stats);
+  /// Compiles `k`, or says why it cannot. Fills `stats` if given.
+  static Result<std::unique_ptr<JitSession>> compile(const kernel::KernelModule& k, const JitOptions& options,
+                                                     JitStats* stats);
   ~JitSession();
   JitSession(const JitSession&) = delete;
   JitSession& operator=(const JitSession&) = delete;
 
   /// The functions of a program, to be called in order with one spill array; empty if the program
   /// was not compiled (JitOptions::compiledPrograms).
-  std::span<const ProgramFn> program(kernel::ProgramId id) const { return parts_[static_cast<size_t>(id)]; }
+  std::span<const ProgramFn> program(ModelProgram p) const { return parts_[programIndex(p)]; }
   /// Doubles of spill memory the program needs.
-  uint32_t spillSlots(kernel::ProgramId id) const { return spill_[static_cast<size_t>(id)]; }
+  uint32_t spillSlots(ModelProgram p) const { return spill_[programIndex(p)]; }
 
  private:
   struct Impl;
   JitSession();
   std::unique_ptr<Impl> impl_;
-  std::array<std::vector<ProgramFn>, kernel::kProgramCount> parts_;
-  std::array<uint32_t, kernel::kProgramCount> spill_{};
+  PerProgram<std::vector<ProgramFn>> parts_;
+  PerProgram<uint32_t> spill_{};
 };
 
 }  // namespace qdot::llvmbackend

@@ -1,98 +1,83 @@
 // The model ABI on top of the JIT: one spill buffer per program; the entry points come from
 // ModelAdapter, this file only calls a compiled program (or interprets one that runs once per
-// simulation and was not worth compiling) and, if an output is not finite, re-runs it
-// on the kernel IR to say which equation produced it (Diagnose.h), stores that for lastError and
-// returns 1.
+// simulation and was not worth compiling) and, if an output is not finite, re-runs it on the
+// kernel IR with the shared diagnosis (qdot/non_finite.hpp) to say which equation produced it,
+// stores that for lastError and returns 1.
 #include "llvm/JitModel.h"
 
-#include <algorithm>
 #include <cmath>
 
-#include "llvm/Diagnose.h"
-#include "qdot/model_adapter.hpp"
 #include "llvm/Jit.h"
+#include "qdot/model_adapter.hpp"
+#include "qdot/non_finite.hpp"
 
 namespace qdot::llvmbackend {
 namespace {
 
-using kernel::ProgramId;
-
-using Call = ModelCall;
-
-// The kernel interpreter's view of a call (for tracing a non-finite result to its equation).
-kernel::Inputs kernelInputs(const kernel::KernelModule& k, const Call& c) {
-  size_t n = k.variableCount(), np = k.parameterNames.size();
-  kernel::Inputs in;
-  in.t = c.t, in.cj = c.cj;
-  if (c.y) in.y = {c.y, n};
-  if (c.yp) in.yp = {c.yp, n};
-  if (c.p) in.p = {c.p, np};
-  if (c.given) in.given = {c.given, np};
-  if (c.overridden) in.overridden = {c.overridden, np};
-  return in;
+// A kernel program as the diagnosis reads it: instruction i defines register i; `ldk` loads the pool.
+ProgramTrace traceOf(const kernel::Program& p) {
+  ProgramTrace trace;
+  for (uint32_t i = 0; i < p.code.size(); ++i) {
+    const kernel::Instr& ins = p.code[i];
+    trace.code.push_back({static_cast<bc::Opcode>(ins.op), i, ins.a, ins.b, ins.c, ins.imm});
+    trace.sources.push_back(ins.source);
+  }
+  trace.constants = p.constants;
+  trace.registerCount = static_cast<uint32_t>(p.code.size());
+  return trace;
 }
 
 struct JitModel : AdaptedModel {
   kernel::KernelModule kernels;
-  std::vector<std::string> where;  // location text per kernel source
+  std::vector<bc::Location> locations;  // per kernel source, for the diagnosis
   std::unique_ptr<JitSession> session;
-  mutable std::array<std::vector<double>, kernel::kProgramCount> spill;
+  mutable PerProgram<std::vector<double>> spill;
 
   /// Calls the compiled program (its parts in order), or interprets one that was not compiled; a
   /// non-finite result is traced on the kernel IR for lastError.
-  int run(ModelProgram program, const Call& c, double* out) const {
-    auto id = static_cast<ProgramId>(program);
+  int run(ModelProgram program, const ModelCall& c, double* out) const {
+    const kernel::Program& code = kernels.program(program);
     const double tcj[2] = {c.t, c.cj};
-    double* scratch = spill[static_cast<size_t>(id)].data();
-    std::span<const ProgramFn> parts = session->program(id);
-    if (parts.empty()) kernel::interpret(kernels.program(id), kernelInputs(kernels, c), {out, kernels.program(id).outputCount});
+    double* scratch = spill[programIndex(program)].data();
+    std::span<const ProgramFn> parts = session->program(program);
+    if (parts.empty()) kernel::interpret(code, c, {out, code.outputCount});
     for (ProgramFn part : parts) part(tcj, c.y, c.yp, c.p, c.given, c.overridden, out, scratch);
-    uint32_t count = kernels.program(id).outputCount;
-    for (uint32_t i = 0; i < count; ++i)
+    for (uint32_t i = 0; i < code.outputCount; ++i)
       if (!std::isfinite(out[i])) {
-        error = diagnoseNonFinite(kernels, id, kernelInputs(kernels, c), where);
+        error = diagnoseNonFinite(kernels.description, locations, program, traceOf(code), c);
         return 1;
       }
     return 0;
   }
 };
 
-static_assert(static_cast<int>(ProgramId::Invariants) == static_cast<int>(ModelProgram::Invariants),
-              "kernel::ProgramId must number the programs in model-ABI order");
-
 // The sizes the ABI relies on (a malformed module would make compiled code write out of bounds).
-bool validate(const kernel::KernelModule& k, std::string& error) {
-  size_t n = k.variableCount();
-  const size_t expected[kernel::kProgramCount] = {k.parameterNames.size(), 3 * n, n, k.jacobianRowIndices.size(),
-                                                  k.outputNames.size(), k.invariantNames.size()};
-  for (size_t i = 0; i < kernel::kProgramCount; ++i)
-    if (k.programs[i].outputCount != expected[i]) {
-      error = "kernel program " + k.programs[i].name + " writes " + std::to_string(k.programs[i].outputCount) +
-              " values, the model ABI expects " + std::to_string(expected[i]);
-      return false;
-    }
-  if (k.jacobianColumnStarts.size() != n + 1 || k.isDifferential.size() != n || k.fixed.size() != n) {
-    error = "kernel module: Jacobian pattern or variable flags do not match the variable count";
-    return false;
+Status validate(const kernel::KernelModule& k) {
+  for (size_t i = 0; i < kModelProgramCount; ++i) {
+    size_t expected = k.description.outputCount(programAt(i));
+    if (k.programs[i].outputCount != expected)
+      return Error{"kernel program " + k.programs[i].name + " writes " + std::to_string(k.programs[i].outputCount) +
+                   " values, the model ABI expects " + std::to_string(expected)};
   }
-  return true;
+  if (std::string e = k.description.inconsistency(); !e.empty()) return Error{"kernel module: " + e};
+  return {};
 }
 
 }  // namespace
 
-QdotModel* createJitModel(const kernel::KernelModule& k, const SourceManager& sm, const JitOptions& options,
-                          std::string& error, JitStats* stats) {
-  if (!validate(k, error)) return nullptr;
-  auto session = JitSession::compile(k, options, error, stats);
-  if (!session) return nullptr;
-  auto* m = new JitModel();
+Result<ModelPtr> createJitModel(const kernel::KernelModule& k, const SourceManager& sm, const JitOptions& options,
+                                JitStats* stats) {
+  if (Status valid = validate(k); !valid) return Error{valid.error()};
+  auto session = JitSession::compile(k, options, stats);
+  if (!session) return Error{session.error()};
+  auto m = std::make_unique<JitModel>();
   m->kernels = k;
-  for (const kernel::Source& s : k.sources) m->where.push_back(kernel::describeLocation(sm, s.range));
-  m->session = std::move(session);
-  for (size_t i = 0; i < kernel::kProgramCount; ++i)
-    m->spill[i].assign(m->session->spillSlots(static_cast<ProgramId>(i)), 0.0);
-  ModelAdapter<JitModel>::install(*m, m->kernels);
-  return m;
+  for (const kernel::Source& s : k.sources)
+    m->locations.push_back({s.label, kernel::describeLocation(sm, s.range), s.text});
+  m->session = std::move(session).value();
+  for (size_t i = 0; i < kModelProgramCount; ++i) m->spill[i].assign(m->session->spillSlots(programAt(i)), 0.0);
+  ModelAdapter<JitModel>::install(*m, m->kernels.description);
+  return ModelPtr(m.release());
 }
 
 }  // namespace qdot::llvmbackend

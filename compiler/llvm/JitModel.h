@@ -3,21 +3,22 @@
 // ABI the bytecode VM implements. No LLVM type appears here; LLVM headers stay in compiler/llvm.
 #pragma once
 
-#include <array>
 #include <atomic>
 #include <cstdint>
 #include <string>
 
 #include "kernel/Kernel.h"
 #include "qdot/model_abi.h"
+#include "qdot/programs.hpp"
+#include "qdot/result.hpp"
 #include "support/SourceManager.h"
 
 namespace qdot::llvmbackend {
 
-/// Bit of kernel::ProgramId `id` in JitOptions::compiledPrograms.
-constexpr uint32_t programBit(kernel::ProgramId id) { return 1u << static_cast<unsigned>(id); }
+/// Bit of `program` in JitOptions::compiledPrograms.
+constexpr uint32_t programBit(ModelProgram program) { return 1u << programIndex(program); }
 /// Every program (tests compile all six, each at one level, to check every lowering).
-constexpr uint32_t kAllPrograms = (1u << kernel::kProgramCount) - 1;
+constexpr uint32_t kAllPrograms = (1u << kModelProgramCount) - 1;
 
 /// How to compile.
 struct JitOptions {
@@ -43,8 +44,8 @@ struct JitOptions {
   size_t largeModelInstructions = 200000;
   /// Programs compiled to machine code (programBit); the others run on the kernel interpreter.
   /// Default: all but parameters and start values, which run once per simulation.
-  uint32_t compiledPrograms = programBit(kernel::ProgramId::Residual) | programBit(kernel::ProgramId::Jacobian) |
-                              programBit(kernel::ProgramId::Outputs) | programBit(kernel::ProgramId::Invariants);
+  uint32_t compiledPrograms = programBit(ModelProgram::Residual) | programBit(ModelProgram::Jacobian) |
+                              programBit(ModelProgram::Outputs) | programBit(ModelProgram::Invariants);
   /// Compile threads; 0 = one per hardware thread (at most 8).
   unsigned threads = 0;
   /// Run LLVM's IR verifier on every module (the tests do; it costs ~60% of lowering, and the
@@ -64,23 +65,23 @@ struct JitStats {
   double wallSeconds = 0;      ///< the whole compile, as the user waits for it
   unsigned threads = 0;        ///< compile threads used
   unsigned units = 0;          ///< modules compiled (each part of a program is in exactly one)
-  std::array<uint32_t, kernel::kProgramCount> functions{};   ///< LLVM functions per program (0: interpreted)
-  std::array<uint32_t, kernel::kProgramCount> spillSlots{};  ///< values passed between them
+  PerProgram<uint32_t> functions{};   ///< LLVM functions per program (0: interpreted)
+  PerProgram<uint32_t> spillSlots{};  ///< values passed between them
 };
 
-/// Compiles every program of `k` and returns a model implementing the whole ABI, or nullptr with
-/// `error` set. `sm` resolves source locations for lastError ("... in equation 3 at model.qd:9").
+/// Compiles every program of `k` and returns a model implementing the whole ABI, or why it cannot.
+/// `sm` resolves source locations for lastError ("... in equation 3 at model.qd:9").
 /// The JIT session lives inside the model; destroy() releases it. Like the VM's models, one model
 /// must not be called from several threads at once (it owns scratch memory).
 /// Fills `stats` if given.
-QdotModel* createJitModel(const kernel::KernelModule& k, const SourceManager& sm, const JitOptions& options,
-                          std::string& error, JitStats* stats = nullptr);
+Result<ModelPtr> createJitModel(const kernel::KernelModule& k, const SourceManager& sm, const JitOptions& options,
+                                JitStats* stats = nullptr);
 
 /// The options for one simulation (qdot run): the defaults, without the invariants unless the run
 /// asks for them.
 inline JitOptions jitOptionsForRun(bool invariants) {
   JitOptions options;
-  if (!invariants) options.compiledPrograms &= ~programBit(kernel::ProgramId::Invariants);
+  if (!invariants) options.compiledPrograms &= ~programBit(ModelProgram::Invariants);
   return options;
 }
 

@@ -20,8 +20,7 @@
 
 namespace qdot::llvmbackend {
 
-bool emitObjectFile(const kernel::KernelModule& k, int optLevel, const std::string& path, ObjectFileInfo& info,
-                    std::string& error) {
+Result<ObjectFileInfo> emitObjectFile(const kernel::KernelModule& k, int optLevel, const std::string& path) {
   static std::once_flag once;
   std::call_once(once, [] {
     llvm::InitializeNativeTarget();
@@ -29,10 +28,7 @@ bool emitObjectFile(const kernel::KernelModule& k, int optLevel, const std::stri
   });
   JitOptions defaults;
   auto jtmb = llvm::orc::JITTargetMachineBuilder::detectHost();
-  if (!jtmb) {
-    error = "LLVM cannot target this host: " + llvm::toString(jtmb.takeError());
-    return false;
-  }
+  if (!jtmb) return Error{"LLVM cannot target this host: " + llvm::toString(jtmb.takeError())};
   size_t instructions = 0;
   for (const kernel::Program& p : k.programs) instructions += p.code.size();
   int level = instructions > defaults.largeModelInstructions ? 0 : optLevel;
@@ -42,41 +38,30 @@ bool emitObjectFile(const kernel::KernelModule& k, int optLevel, const std::stri
                                         : llvm::CodeGenOpt::Aggressive);
   jtmb->setRelocationModel(llvm::Reloc::PIC_);
   auto tm = jtmb->createTargetMachine();
-  if (!tm) {
-    error = "LLVM target machine: " + llvm::toString(tm.takeError());
-    return false;
-  }
+  if (!tm) return Error{"LLVM target machine: " + llvm::toString(tm.takeError())};
   llvm::LLVMContext ctx;
   LoweredModule lowered = lowerKernels(k, ctx, defaults.maxInstructionsPerFunction);
   lowered.module->setDataLayout((*tm)->createDataLayout());
   lowered.module->setTargetTriple((*tm)->getTargetTriple().str());
   std::string verifyErrors;
   llvm::raw_string_ostream vos(verifyErrors);
-  if (llvm::verifyModule(*lowered.module, &vos)) {
-    error = "internal error: invalid LLVM IR: " + vos.str();
-    return false;
-  }
+  if (llvm::verifyModule(*lowered.module, &vos)) return Error{"internal error: invalid LLVM IR: " + vos.str()};
   std::error_code ec;
   llvm::raw_fd_ostream out(path, ec, llvm::sys::fs::OF_None);
-  if (ec) {
-    error = "cannot write " + path + ": " + ec.message();
-    return false;
-  }
+  if (ec) return Error{"cannot write " + path + ": " + ec.message()};
   llvm::legacy::PassManager pm;
-  if ((*tm)->addPassesToEmitFile(pm, out, nullptr, llvm::CGFT_ObjectFile)) {
-    error = "LLVM cannot emit an object file for this target";
-    return false;
-  }
+  if ((*tm)->addPassesToEmitFile(pm, out, nullptr, llvm::CGFT_ObjectFile))
+    return Error{"LLVM cannot emit an object file for this target"};
   pm.run(*lowered.module);
   out.flush();
   if (out.has_error()) {
-    error = "cannot write " + path;
     out.clear_error();
-    return false;
+    return Error{"cannot write " + path};
   }
+  ObjectFileInfo info;
   info.entryNames = lowered.entryNames;
   info.spillSlots = lowered.spillSlots;
-  return true;
+  return info;
 }
 
 }  // namespace qdot::llvmbackend

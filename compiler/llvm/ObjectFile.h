@@ -3,23 +3,23 @@
 // object file for the host. No LLVM type here.
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <string>
 
 #include "kernel/Kernel.h"
+#include "qdot/programs.hpp"
+#include "qdot/result.hpp"
 
 namespace qdot::llvmbackend {
 
-/// What the code in an object file offers, per kernel::ProgramId.
+/// What the code in an object file offers, per program.
 struct ObjectFileInfo {
-  std::array<std::string, kernel::kProgramCount> entryNames;  ///< "qdot_residual", ... (ProgramFn, Jit.h)
-  std::array<uint32_t, kernel::kProgramCount> spillSlots{};   ///< doubles of scratch each needs
+  PerProgram<std::string> entryNames;  ///< "qdot_residual", ... (ProgramFn, Jit.h)
+  PerProgram<uint32_t> spillSlots{};   ///< doubles of scratch each needs
 };
 
-/// Compiles every program of `k` for the host (position-independent) into the object file `path`.
-/// False with `error` on failure.
-bool emitObjectFile(const kernel::KernelModule& k, int optLevel, const std::string& path, ObjectFileInfo& info,
-                    std::string& error);
+/// Compiles every program of `k` for the host (position-independent) into the object file `path`;
+/// what it offers, or why it could not be written.
+Result<ObjectFileInfo> emitObjectFile(const kernel::KernelModule& k, int optLevel, const std::string& path);
 
 }  // namespace qdot::llvmbackend

@@ -8,12 +8,13 @@
 
 #include "exe/Embedded.h"
 #include "qdot/model_abi.h"
+#include "qdot/result.hpp"
 
 namespace qdot::exe {
 
 /// A model of the serialised module `bytes` whose programs run as `programs` (with `spill` doubles
-/// of scratch each). nullptr with `error` if the bytes are not a valid module.
-QdotModel* createNativeModel(std::span<const uint8_t> bytes, const qdot_program_fn programs[6],
-                             const uint32_t spill[6], std::string& error);
+/// of scratch each), or why the bytes are not a valid module.
+Result<ModelPtr> createNativeModel(std::span<const uint8_t> bytes, const qdot_program_fn programs[6],
+                                   const uint32_t spill[6]);
 
 }  // namespace qdot::exe

@@ -54,14 +54,15 @@ std::string parameterHelp(const QdotModel& model) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string error;
   std::span<const uint8_t> bytes(qdot_model_bytes, qdot_model_size);
-  QdotModel* model = qdot_native_programs[0] ? exe::createNativeModel(bytes, qdot_native_programs, qdot_native_spill, error)
-                                             : vm::createModelFromBytes(bytes, error);
-  if (!model) {
-    std::cerr << "error: the embedded model is invalid: " << error << "\n";
+  Result<ModelPtr> created = qdot_native_programs[0]
+                                 ? exe::createNativeModel(bytes, qdot_native_programs, qdot_native_spill)
+                                 : vm::createModelFromBytes(bytes);
+  if (!created) {
+    std::cerr << "error: the embedded model is invalid: " << created.error() << "\n";
     return 4;
   }
+  QdotModel* model = created->get();
   CLI::App app{fmt::format("{}: a qdot model; simulates it with SUNDIALS IDA and writes the results as CSV",
                            model->name ? model->name : "model")};
   rt::RunOptions options;
@@ -80,6 +81,5 @@ int main(int argc, char** argv) {
     std::cerr << "error: internal error: " << e.what() << "\n";
     code = 4;
   }
-  model->destroy(model);
   return code;
 }

@@ -10,8 +10,8 @@ namespace qdot::rt {
 namespace {
 
 struct Tiered : QdotModel {
-  QdotModel* first = nullptr;
-  std::atomic<QdotModel*> second{nullptr};
+  ModelPtr first;
+  std::atomic<QdotModel*> second{nullptr};  // owned (published once, released by destroy)
   std::atomic<bool> cancel{false};
   std::thread compiler;
   std::chrono::steady_clock::time_point created = std::chrono::steady_clock::now();
@@ -23,7 +23,7 @@ struct Tiered : QdotModel {
   const QdotModel& active() const {
     const QdotModel* m = second.load(std::memory_order_acquire);
     if (m) ++secondCalls;
-    else m = first, ++firstCalls;
+    else m = first.get(), ++firstCalls;
     last = m;
     return *m;
   }
@@ -66,39 +66,35 @@ int invariants(const QdotModel* s, double t, const double* y, const double* yp, 
   return m.invariants(&m, t, y, yp, p, out);
 }
 const char* lastError(const QdotModel* s) {
-  const QdotModel* m = self(s).last ? self(s).last : self(s).first;
+  const QdotModel* m = self(s).last ? self(s).last : self(s).first.get();
   return m->lastError(m);
 }
 void destroy(QdotModel* s) {
   auto* t = static_cast<Tiered*>(s);
   t->join();
-  if (QdotModel* second = t->second.load()) second->destroy(second);
-  t->first->destroy(t->first);
+  ModelPtr second(t->second.load());
   delete t;
 }
 
 }  // namespace
 
-QdotModel* createTieredModel(QdotModel* first, TierCompiler compile) {
+ModelPtr createTieredModel(ModelPtr first, TierCompiler compile) {
   auto* t = new Tiered();
   static_cast<QdotModel&>(*t) = *first;  // sizes, names, pattern: the first tier's
-  t->first = first;
+  t->first = std::move(first);
   t->parameters = parameters, t->initialValues = initialValues, t->fixedStarts = fixedStarts;
   t->residual = residual, t->jacobian = jacobian, t->outputs = outputs, t->invariants = invariants;
   t->lastError = lastError, t->destroy = destroy;
   t->compiler = std::thread([t, compile = std::move(compile)] {
-    QdotModel* second = compile(t->cancel);
-    if (second && t->cancel.load()) {  // too late: the run is over
-      second->destroy(second);
-      second = nullptr;
-    }
+    ModelPtr second = compile(t->cancel);
+    if (second && t->cancel.load()) second.reset();  // too late: the run is over
     if (second) {
       t->readySeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t->created).count();
-      t->second.store(second, std::memory_order_release);
+      t->second.store(second.release(), std::memory_order_release);
     }
     t->done.store(true, std::memory_order_release);
   });
-  return t;
+  return ModelPtr(t);
 }
 
 std::optional<TierReport> tierReport(const QdotModel* model) {

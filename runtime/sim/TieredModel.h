@@ -14,12 +14,13 @@
 #include <string>
 
 #include "qdot/model_abi.h"
+#include "qdot/result.hpp"
 
 namespace qdot::rt {
 
-/// Builds the second tier; may return nullptr (the run stays on the first). Should give up early,
-/// returning nullptr, once `cancel` is set (the run ended before it was done).
-using TierCompiler = std::function<QdotModel*(const std::atomic<bool>& cancel)>;
+/// Builds the second tier; may return null (the run stays on the first). Should give up early,
+/// returning null, once `cancel` is set (the run ended before it was done).
+using TierCompiler = std::function<ModelPtr(const std::atomic<bool>& cancel)>;
 
 /// What happened to the second tier so far.
 struct TierReport {
@@ -33,7 +34,7 @@ struct TierReport {
 /// Creates the tiered model; owns `first` and whatever `compile` returns. compile runs on its own
 /// thread at once. destroy() cancels and joins it (a program about to exit need not wait for it:
 /// qdot run ends with _Exit when the compile is still running, tierReport().compiling).
-QdotModel* createTieredModel(QdotModel* first, TierCompiler compile);
+ModelPtr createTieredModel(ModelPtr first, TierCompiler compile);
 
 /// The report of a model made by createTieredModel, without waiting; nullopt for any other model.
 /// Call it from the thread that calls the model. Once `compiling` is false, whatever the compile

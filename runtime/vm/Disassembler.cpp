@@ -21,9 +21,9 @@ std::string reg(uint32_t r) { return std::string("r").append(std::to_string(r));
 
 std::string indexName(const bc::Module& m, bc::Opcode op, uint32_t i, const bc::Function& f) {
   const std::vector<std::string>* names = nullptr;
-  if (op == bc::Opcode::LoadY || op == bc::Opcode::LoadYp) names = &m.variableNames;
+  if (op == bc::Opcode::LoadY || op == bc::Opcode::LoadYp) names = &m.description.variableNames;
   if (op == bc::Opcode::LoadP || op == bc::Opcode::LoadGiven || op == bc::Opcode::LoadOverridden)
-    names = &m.parameterNames;
+    names = &m.description.parameterNames;
   if (op == bc::Opcode::LoadConst && i < f.constants.size()) return std::to_string(i) + std::string(" (").append(num(f.constants[i])) + ")";
   return std::to_string(i) + (names && i < names->size() ? std::string(" (").append((*names)[i]) + ")" : "");
 }
@@ -53,10 +53,10 @@ void printSource(std::ostream& os, const bc::Module& m, uint32_t loc) {
 
 }  // namespace
 
-void disassembleFunction(std::ostream& os, const bc::Module& m, bc::FunctionId id) {
-  const bc::Function& f = m.function(id);
+void disassembleFunction(std::ostream& os, const bc::Module& m, ModelProgram program) {
+  const bc::Function& f = m.function(program);
   size_t instructions = f.sources.size();
-  os << "\nfunction " << bc::kFunctionNames[static_cast<int>(id)] << ": " << f.registerCount << " registers ("
+  os << "\nfunction " << programName(program) << ": " << f.registerCount << " registers ("
      << f.constants.size() << " constants), " << f.outputCount << " outputs, " << instructions << " instructions, "
      << f.code.size() << " words\n";
   for (size_t k = 0; k < f.constants.size(); ++k) os << "  " << reg(k) << " = " << num(f.constants[k]) << "\n";
@@ -78,10 +78,11 @@ void disassembleFunction(std::ostream& os, const bc::Module& m, bc::FunctionId i
 }
 
 void disassemble(std::ostream& os, const bc::Module& m) {
-  os << "bytecode " << m.name << " (format " << bc::kFormatVersion << "): " << m.variableNames.size()
-     << " variables, " << m.parameterNames.size() << " parameters, " << m.outputNames.size() << " outputs, "
-     << m.invariantNames.size() << " invariants, " << m.jacobianRowIndices.size() << " Jacobian nonzeros\n";
-  for (uint32_t f = 0; f < bc::kFunctionCount; ++f) disassembleFunction(os, m, static_cast<bc::FunctionId>(f));
+  const ModelDescription& d = m.description;
+  os << "bytecode " << d.name << " (format " << bc::kFormatVersion << "): " << d.variableNames.size()
+     << " variables, " << d.parameterNames.size() << " parameters, " << d.outputNames.size() << " outputs, "
+     << d.invariantNames.size() << " invariants, " << d.jacobianRowIndices.size() << " Jacobian nonzeros\n";
+  for (size_t f = 0; f < kModelProgramCount; ++f) disassembleFunction(os, m, programAt(f));
 }
 
 }  // namespace qdot::vm

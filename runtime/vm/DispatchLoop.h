@@ -28,7 +28,7 @@
 namespace qdot::vm::detail {
 
 #if defined(__GNUC__) || defined(__clang__)
-inline void loopComputedGoto(const uint32_t* ip, double* __restrict r, const Inputs& in, const double* k,
+inline void loopComputedGoto(const uint32_t* ip, double* __restrict r, const ModelCall& in, const double* k,
                              double* __restrict out) {
   QDOT_VM_INPUTS
   static const void* const handlers[] = {
@@ -42,7 +42,7 @@ inline void loopComputedGoto(const uint32_t* ip, double* __restrict r, const Inp
 }
 #endif
 
-inline void loopSwitch(const uint32_t* ip, double* r, const Inputs& in, const double* k, double* out) {
+inline void loopSwitch(const uint32_t* ip, double* r, const ModelCall& in, const double* k, double* out) {
   QDOT_VM_INPUTS
   for (;;) {
     switch (static_cast<bc::Opcode>(*ip)) {

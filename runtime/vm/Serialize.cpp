@@ -107,49 +107,53 @@ Function readFunction(Reader& r) {
   return f;
 }
 
+// The description's fields in declaration order.
+void writeDescription(Writer& w, const ModelDescription& d) {
+  w.str(d.name);
+  for (const auto* names : {&d.variableNames, &d.parameterNames, &d.parameterDescriptions, &d.outputNames,
+                            &d.invariantNames})
+    w.strings(*names);
+  for (const auto* ints : {&d.isDifferential, &d.fixed, &d.jacobianColumnStarts, &d.jacobianRowIndices})
+    w.words(*ints);
+}
+
+ModelDescription readDescription(Reader& r) {
+  ModelDescription d;
+  d.name = r.str();
+  for (auto* names : {&d.variableNames, &d.parameterNames, &d.parameterDescriptions, &d.outputNames,
+                      &d.invariantNames})
+    *names = r.strings();
+  for (auto* ints : {&d.isDifferential, &d.fixed, &d.jacobianColumnStarts, &d.jacobianRowIndices})
+    *ints = r.words<int32_t>();
+  return d;
+}
+
 }  // namespace
 
 std::vector<uint8_t> serialize(const Module& m) {
   Writer w;
   w.bytes.assign(kMagic, kMagic + 4);
   w.u32(kFormatVersion);
-  w.str(m.name);
-  for (const auto* names : {&m.variableNames, &m.parameterNames, &m.parameterDescriptions, &m.outputNames,
-                            &m.invariantNames})
-    w.strings(*names);
-  for (const auto* ints : {&m.isDifferential, &m.fixed, &m.jacobianColumnStarts, &m.jacobianRowIndices})
-    w.words(*ints);
+  writeDescription(w, m.description);
   for (const Function& f : m.functions) writeFunction(w, f);
   w.u32(static_cast<uint32_t>(m.locations.size()));
   for (const Location& l : m.locations) w.str(l.label), w.str(l.where), w.str(l.text);
   return std::move(w.bytes);
 }
 
-bool deserialize(std::span<const uint8_t> bytes, Module& m, std::string& error) {
-  if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 4) != 0) {
-    error = "not qdot bytecode (no QDBC header)";
-    return false;
-  }
+Result<Module> deserialize(std::span<const uint8_t> bytes) {
+  if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 4) != 0) return Error{"not qdot bytecode (no QDBC header)"};
   Reader r(bytes.subspan(4));
-  if (uint32_t version = r.u32(); version != kFormatVersion) {
-    error = "bytecode format version " + std::to_string(version) + ", expected " + std::to_string(kFormatVersion);
-    return false;
-  }
-  m = Module();
-  m.name = r.str();
-  for (auto* names : {&m.variableNames, &m.parameterNames, &m.parameterDescriptions, &m.outputNames,
-                      &m.invariantNames})
-    *names = r.strings();
-  for (auto* ints : {&m.isDifferential, &m.fixed, &m.jacobianColumnStarts, &m.jacobianRowIndices})
-    *ints = r.words<int32_t>();
+  if (uint32_t version = r.u32(); version != kFormatVersion)
+    return Error{"bytecode format version " + std::to_string(version) + ", expected " + std::to_string(kFormatVersion)};
+  Module m;
+  m.description = readDescription(r);
   for (Function& f : m.functions) f = readFunction(r);
   m.locations.resize(r.count(12));
   for (Location& l : m.locations) l.label = r.str(), l.where = r.str(), l.text = r.str();
-  if (!r.ok() || !r.atEnd()) {
-    error = r.ok() ? "trailing bytes after the bytecode module" : "truncated bytecode module";
-    return false;
-  }
-  return validate(m, error);
+  if (!r.ok() || !r.atEnd()) return Error{r.ok() ? "trailing bytes after the bytecode module" : "truncated bytecode module"};
+  if (Status valid = validate(m); !valid) return Error{valid.error()};
+  return m;
 }
 
 }  // namespace qdot::bc

@@ -1,49 +1,33 @@
 // bc::validate: everything the interpreter trusts without checking at run time — opcodes in
 // range, operands inside the register file, constant registers never written, load indices
-// inside their inputs, each function loading only what its ABI entry point passes, stores inside
-// the outputs, one `ret` at the end, sizes and the CSC pattern consistent.
+// inside their inputs, each function loading only what its ABI entry point passes (qdot/programs.def),
+// stores inside the outputs, one `ret` at the end, the description (sizes, CSC pattern) consistent.
 #include "qdot/bytecode.h"
 
 namespace qdot::bc {
 namespace {
 
-struct Sizes {
-  uint32_t variables, parameters, outputs, invariants, nonzeros;
-};
-
-uint32_t expectedOutputs(FunctionId id, const Sizes& s) {
-  switch (id) {
-    case FunctionId::Parameters: return s.parameters;
-    case FunctionId::InitialValues: return 3 * s.variables;
-    case FunctionId::Residual: return s.variables;
-    case FunctionId::Jacobian: return s.nonzeros;
-    case FunctionId::Outputs: return s.outputs;
-    case FunctionId::Invariants: return s.invariants;
-  }
-  return 0;
-}
-
-// Which inputs each entry point passes.
-bool loadAllowed(FunctionId id, Opcode op) {
+// Which inputs each entry point passes (qdot/programs.def).
+bool loadAllowed(ModelProgram program, Opcode op) {
+  uint32_t inputs = programInputs(program);
   switch (op) {
-    case Opcode::LoadConst: return true;
-    case Opcode::LoadGiven:
-    case Opcode::LoadOverridden: return id == FunctionId::Parameters;
-    case Opcode::LoadTime:
-    case Opcode::LoadP: return id != FunctionId::Parameters;
-    case Opcode::LoadY:
-    case Opcode::LoadYp: return id != FunctionId::Parameters && id != FunctionId::InitialValues;
-    case Opcode::LoadCj: return id == FunctionId::Jacobian;
+    case Opcode::LoadTime: return inputs & InputTime;
+    case Opcode::LoadCj: return inputs & InputCj;
+    case Opcode::LoadY: return inputs & InputY;
+    case Opcode::LoadYp: return inputs & InputYp;
+    case Opcode::LoadP: return inputs & InputP;
+    case Opcode::LoadGiven: return inputs & InputGiven;
+    case Opcode::LoadOverridden: return inputs & InputOverridden;
     default: return true;
   }
 }
 
 class FunctionChecker {
  public:
-  FunctionChecker(const Module& m, FunctionId id, const Sizes& s) : m_(m), f_(m.function(id)), id_(id), s_(s) {}
+  FunctionChecker(const Module& m, ModelProgram program) : m_(m), d_(m.description), f_(m.function(program)), program_(program) {}
 
   std::string check() {
-    if (f_.outputCount != expectedOutputs(id_, s_)) return "wrong output count";
+    if (f_.outputCount != d_.outputCount(program_)) return "wrong output count";
     if (f_.constants.size() > f_.registerCount) return "more constants than registers";
     size_t pc = 0;
     uint32_t instructions = 0;
@@ -74,17 +58,17 @@ class FunctionChecker {
   bool indexOk(Opcode op, uint32_t i) const {
     switch (op) {
       case Opcode::LoadY:
-      case Opcode::LoadYp: return i < s_.variables;
+      case Opcode::LoadYp: return i < d_.variableCount();
       case Opcode::LoadP:
       case Opcode::LoadGiven:
-      case Opcode::LoadOverridden: return i < s_.parameters;
+      case Opcode::LoadOverridden: return i < d_.parameterCount();
       case Opcode::LoadConst: return i < f_.constants.size();
       default: return false;
     }
   }
 
   std::string operands(Opcode op, const uint32_t* o) const {
-    if (!loadAllowed(id_, op)) return std::string(info(op).mnemonic) + " is not available in this function";
+    if (!loadAllowed(program_, op)) return std::string(info(op).mnemonic) + " is not available in this function";
     bool ok = true;
     switch (info(op).format) {
       case Format::End: break;
@@ -100,46 +84,25 @@ class FunctionChecker {
   }
 
   const Module& m_;
+  const ModelDescription& d_;
   const Function& f_;
-  FunctionId id_;
-  Sizes s_;
+  ModelProgram program_;
 };
 
-std::string checkPattern(const Module& m) {
-  size_t n = m.variableNames.size();
-  const auto& starts = m.jacobianColumnStarts;
-  const auto& rows = m.jacobianRowIndices;
-  if (starts.size() != n + 1 || starts[0] != 0 || static_cast<size_t>(starts[n]) != rows.size())
-    return "Jacobian column starts are inconsistent";
-  for (size_t j = 0; j < n; ++j) {
-    if (starts[j] > starts[j + 1]) return "Jacobian column starts decrease";
-    for (int32_t k = starts[j]; k < starts[j + 1]; ++k)
-      if (rows[k] < 0 || static_cast<size_t>(rows[k]) >= n || (k > starts[j] && rows[k] <= rows[k - 1]))
-        return "Jacobian row indices out of range or not ascending in column " + std::to_string(j);
-  }
-  return "";
-}
-
 std::string checkModule(const Module& m) {
-  size_t n = m.variableNames.size();
-  if (m.isDifferential.size() != n || m.fixed.size() != n) return "per-variable tables have the wrong size";
-  if (m.parameterDescriptions.size() != m.parameterNames.size()) return "parameter descriptions have the wrong size";
-  if (std::string e = checkPattern(m); !e.empty()) return e;
-  Sizes s{static_cast<uint32_t>(n), static_cast<uint32_t>(m.parameterNames.size()),
-          static_cast<uint32_t>(m.outputNames.size()), static_cast<uint32_t>(m.invariantNames.size()),
-          static_cast<uint32_t>(m.jacobianRowIndices.size())};
-  for (uint32_t f = 0; f < kFunctionCount; ++f) {
-    std::string e = FunctionChecker(m, static_cast<FunctionId>(f), s).check();
-    if (!e.empty()) return std::string("function ") + kFunctionNames[f] + ": " + e;
+  if (std::string e = m.description.inconsistency(); !e.empty()) return e;
+  for (size_t f = 0; f < kModelProgramCount; ++f) {
+    std::string e = FunctionChecker(m, programAt(f)).check();
+    if (!e.empty()) return std::string("function ") + kModelProgramNames[f] + ": " + e;
   }
   return "";
 }
 
 }  // namespace
 
-bool validate(const Module& m, std::string& error) {
-  error = checkModule(m);
-  return error.empty();
+Status validate(const Module& m) {
+  if (std::string e = checkModule(m); !e.empty()) return Error{std::move(e)};
+  return {};
 }
 
 }  // namespace qdot::bc

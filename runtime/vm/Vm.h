@@ -4,24 +4,22 @@
 
 #include <iosfwd>
 #include <span>
-#include <string>
 
 #include "qdot/bytecode.h"
-#include "qdot/model_abi.h"
+#include "qdot/result.hpp"
 
 namespace qdot::vm {
 
-/// A model running `module` (copied). Returns nullptr, with `error` set, if the module does not
-/// validate. Release it with model->destroy(model). One instance must not be called from two
-/// threads at once (it owns its register files); create one per thread instead.
-QdotModel* createModel(const bc::Module& module, std::string& error);
+/// A model running `module`, or why the module does not validate. One instance must not
+/// be called from two threads at once (it owns its register files); create one per thread instead.
+Result<ModelPtr> createModel(bc::Module module);
 /// The same from serialised bytes (bc::serialize).
-QdotModel* createModelFromBytes(std::span<const uint8_t> bytes, std::string& error);
+Result<ModelPtr> createModelFromBytes(std::span<const uint8_t> bytes);
 
 /// Text of every function: constants, then one instruction per line with its word offset and,
 /// whenever it changes, the source it serves. Deterministic.
 void disassemble(std::ostream& os, const bc::Module& m);
 /// One function of m.
-void disassembleFunction(std::ostream& os, const bc::Module& m, bc::FunctionId id);
+void disassembleFunction(std::ostream& os, const bc::Module& m, ModelProgram program);
 
 }  // namespace qdot::vm

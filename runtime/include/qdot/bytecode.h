@@ -1,6 +1,6 @@
-// qdot bytecode: the plain data a compiled model is to the VM — per ABI function a register
-// program (opcode words from qdot/opcodes.def, a constant pool, an instruction → source table),
-// plus the model's names, sizes and CSC Jacobian pattern. Written by the compiler
+// qdot bytecode: the plain data a compiled model is to the VM — per model program (qdot/programs.def)
+// a register program (opcode words from qdot/opcodes.def, a constant pool, an instruction → source
+// table), plus the model's description (qdot/model_description.hpp: names, flags, CSC pattern). Written by the compiler
 // (compiler/bytecode), run by runtime/vm, and serialisable so executables can embed it.
 #ifndef QDOT_BYTECODE_H
 #define QDOT_BYTECODE_H
@@ -13,6 +13,10 @@
 #include <string_view>
 #include <vector>
 
+#include "qdot/model_description.hpp"
+#include "qdot/programs.hpp"
+#include "qdot/result.hpp"
+
 namespace qdot::bc {
 
 /// Every opcode, in qdot/opcodes.def order.
@@ -21,8 +25,51 @@ enum class Opcode : uint8_t {
 #include "qdot/opcodes.def"
 };
 
+/// The instruction formats of qdot/opcodes.def: X(Name, operand words, registers read). The one
+/// arity table: the encoder, the validator, the VM, the kernel IR and the diagnosis all use it.
+#define QDOT_INSTRUCTION_FORMATS(X) \
+  X(End, 0, 0)                      \
+  X(None, 1, 0)                     \
+  X(Index, 2, 0)                    \
+  X(Unary, 2, 1)                    \
+  X(Binary, 3, 2)                   \
+  X(Ternary, 4, 3)                  \
+  X(UnaryIndex, 3, 1)               \
+  X(Store, 2, 1)
+
 /// Operand layout of an instruction (see the table at the top of qdot/opcodes.def).
-enum class Format : uint8_t { End, None, Index, Unary, Binary, Ternary, UnaryIndex, Store };
+enum class Format : uint8_t {
+#define QDOT_FORMAT_ENUM(Name, Words, Reads) Name,
+  QDOT_INSTRUCTION_FORMATS(QDOT_FORMAT_ENUM)
+#undef QDOT_FORMAT_ENUM
+};
+
+/// Number of u32 operand words after the opcode word.
+inline constexpr uint32_t operandCount(Format f) {
+  constexpr uint32_t words[] = {
+#define QDOT_FORMAT_WORDS(Name, Words, Reads) Words,
+      QDOT_INSTRUCTION_FORMATS(QDOT_FORMAT_WORDS)
+#undef QDOT_FORMAT_WORDS
+  };
+  return words[static_cast<uint8_t>(f)];
+}
+
+/// Number of registers an instruction of format f reads (operands a, b, c in that order).
+inline constexpr uint32_t readCount(Format f) {
+  constexpr uint32_t reads[] = {
+#define QDOT_FORMAT_READS(Name, Words, Reads) Reads,
+      QDOT_INSTRUCTION_FORMATS(QDOT_FORMAT_READS)
+#undef QDOT_FORMAT_READS
+  };
+  return reads[static_cast<uint8_t>(f)];
+}
+
+/// True if an instruction of format f writes a register (all but End and Store).
+inline constexpr bool definesRegister(Format f) { return f != Format::End && f != Format::Store; }
+/// True if the last operand word is an immediate (an input/pool index, an exponent, an output slot).
+inline constexpr bool hasImmediate(Format f) {
+  return f == Format::Index || f == Format::UnaryIndex || f == Format::Store;
+}
 
 /// What the disassembler and the validator need to know about an opcode.
 struct OpcodeInfo {
@@ -40,10 +87,25 @@ inline constexpr uint32_t kOpcodeCount = sizeof(kOpcodes) / sizeof(kOpcodes[0]);
 /// The table entry of op.
 inline const OpcodeInfo& info(Opcode op) { return kOpcodes[static_cast<uint8_t>(op)]; }
 
-/// Number of u32 operand words after the opcode word.
-inline constexpr uint32_t operandCount(Format f) {
-  constexpr uint32_t counts[] = {0, 1, 2, 2, 3, 4, 3, 2};
-  return counts[static_cast<uint8_t>(f)];
+/// An instruction with its operands named as in the kernel IR: `dest` the register it defines,
+/// a, b, c the registers it reads, `imm` its immediate (for `st`: the output slot).
+struct Instruction {
+  Opcode op = Opcode::Ret;
+  uint32_t dest = 0, a = 0, b = 0, c = 0, imm = 0;
+};
+
+/// The instruction whose opcode word is ip[0] (layout: dest, registers read, immediate; `st`: slot, a).
+inline Instruction decode(const uint32_t* ip) {
+  Instruction ins;
+  ins.op = static_cast<Opcode>(ip[0]);
+  Format f = info(ins.op).format;
+  const uint32_t* o = ip + 1;
+  if (definesRegister(f)) ins.dest = *o++;
+  if (f == Format::Store) ins.imm = *o++;
+  uint32_t* reads[3] = {&ins.a, &ins.b, &ins.c};
+  for (uint32_t i = 0; i < readCount(f); ++i) *reads[i] = *o++;
+  if (f == Format::Index || f == Format::UnaryIndex) ins.imm = *o;
+  return ins;
 }
 
 /// The opcode spelled `mnemonic`; false if there is none.
@@ -71,12 +133,6 @@ inline double powi(double x, int32_t n) {
 /// sign(x): 1, -1, 0 for 0, NaN for NaN (as compiler/symbolic evaluates it).
 inline double sign(double x) { return x > 0.0 ? 1.0 : (x < 0.0 ? -1.0 : (x == 0.0 ? 0.0 : x)); }
 
-/// The functions of the model ABI that are programs (fixedStarts is a table, not a program).
-enum class FunctionId : uint8_t { Parameters, InitialValues, Residual, Jacobian, Outputs, Invariants };
-inline constexpr uint32_t kFunctionCount = 6;
-inline constexpr const char* kFunctionNames[kFunctionCount] = {"parameters", "initialValues", "residual",
-                                                               "jacobian",   "outputs",       "invariants"};
-
 /// Function::sources entry of an instruction that serves no particular source.
 inline constexpr uint32_t kNoSource = UINT32_MAX;
 
@@ -99,31 +155,27 @@ struct Location {
 };
 
 /// Version of the serialised form; deserialize refuses any other.
-inline constexpr uint32_t kFormatVersion = 1;
+inline constexpr uint32_t kFormatVersion = 2;
 
-/// A whole model. Sizes are the lengths of the name vectors.
+/// A whole model: its description (names, flags, Jacobian pattern) and one function per program.
 struct Module {
-  std::string name;
-  std::vector<std::string> variableNames, parameterNames, parameterDescriptions, outputNames, invariantNames;
-  std::vector<int32_t> isDifferential;  ///< [nVariables]
-  std::vector<int32_t> fixed;           ///< [nVariables]: start value fixed during initialisation
-  std::vector<int32_t> jacobianColumnStarts, jacobianRowIndices;  ///< CSC, column j = variable j
-  std::array<Function, kFunctionCount> functions;
+  ModelDescription description;
+  PerProgram<Function> functions;
   std::vector<Location> locations;
 
-  Function& function(FunctionId id) { return functions[static_cast<uint8_t>(id)]; }
-  const Function& function(FunctionId id) const { return functions[static_cast<uint8_t>(id)]; }
+  Function& function(ModelProgram p) { return functions[programIndex(p)]; }
+  const Function& function(ModelProgram p) const { return functions[programIndex(p)]; }
 };
 
 // Implemented in runtime/vm (qdot_vm).
 
 /// Little-endian bytes: magic "QDBC", kFormatVersion, then every field in declaration order.
 std::vector<uint8_t> serialize(const Module& m);
-/// Reads bytes written by serialize and validates them; false (with `error`) if malformed.
-bool deserialize(std::span<const uint8_t> bytes, Module& m, std::string& error);
+/// Reads bytes written by serialize and validates them; the error says what is malformed.
+Result<Module> deserialize(std::span<const uint8_t> bytes);
 /// Checks everything the VM relies on (opcodes, operand ranges, loads allowed per function,
-/// constant registers never written, sizes consistent); false with `error` naming the first problem.
-bool validate(const Module& m, std::string& error);
+/// constant registers never written, the description consistent); the error names the first problem.
+Status validate(const Module& m);
 
 }  // namespace qdot::bc
 

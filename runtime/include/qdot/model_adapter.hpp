@@ -11,37 +11,12 @@
 
 #include "qdot/model_abi.h"
 #include "qdot/model_table.hpp"
+#include "qdot/programs.hpp"
 
 namespace qdot {
 
-/// The inputs of one call of a compiled program (unused ones stay null/0).
-struct ModelCall {
-  double t = 0, cj = 0;
-  const double* y = nullptr;
-  const double* yp = nullptr;
-  const double* p = nullptr;
-  const double* given = nullptr;
-  const uint8_t* overridden = nullptr;
-};
-
-/// The programs in model-ABI order (kernel::ProgramId and bc::FunctionId number them the same).
-enum class ModelProgram : uint8_t { Parameters, InitialValues, Residual, Jacobian, Outputs, Invariants };
-
-/// How many values a program writes for model `m` (initialValues: y0, yp0 and nominal).
-inline size_t programOutputCount(const QdotModel& m, ModelProgram program) {
-  switch (program) {
-    case ModelProgram::Parameters: return m.nParameters;
-    case ModelProgram::InitialValues: return 3 * size_t{m.nVariables};
-    case ModelProgram::Residual: return m.nVariables;
-    case ModelProgram::Jacobian: return m.jacobianNonzeros;
-    case ModelProgram::Outputs: return m.nOutputs;
-    case ModelProgram::Invariants: return m.nInvariants;
-  }
-  return 0;
-}
-
 /// Calls program `program` of any model through its ABI table (the inverse of ModelAdapter);
-/// `out` has programOutputCount values. Used to re-run a call on another backend.
+/// `out` has ModelDescription::outputCount(program) values. Used to re-run a call on another backend.
 inline int callProgram(const QdotModel& m, ModelProgram program, const ModelCall& c, double* out) {
   size_t n = m.nVariables;
   switch (program) {
@@ -58,7 +33,7 @@ inline int callProgram(const QdotModel& m, ModelProgram program, const ModelCall
 /// State every adapted model carries next to its backend data.
 struct AdaptedModel : QdotModel {
   ModelNameTable names;                      ///< what the table's name arrays point into
-  const int32_t* fixedFlags = nullptr;       ///< [nVariables], owned by the backend's module
+  const int32_t* fixedFlags = nullptr;       ///< [nVariables], owned by the backend's description
   std::vector<double> noneGiven;             ///< used when the runtime passes no given values
   std::vector<uint8_t> noneOverridden;
   mutable std::vector<double> startScratch;  ///< [y0 | yp0 | nominal]
@@ -69,11 +44,11 @@ struct AdaptedModel : QdotModel {
 /// returning nonzero (with `error` set) when an output is not finite.
 template <class Model>
 struct ModelAdapter {
-  /// Fills the table of `m` from `module` (names, pattern) and points its functions here.
-  template <class Module>
-  static void install(Model& m, const Module& module) {
-    fillModelTable(m, m.names, module);
-    m.fixedFlags = module.fixed.data();
+  /// Points the table of `m` at `description` (names, pattern; it must outlive `m`) and its
+  /// functions here.
+  static void install(Model& m, const ModelDescription& description) {
+    fillModelTable(m, m.names, description);
+    m.fixedFlags = description.fixed.data();
     m.noneGiven.assign(m.nParameters, 0.0);
     m.noneOverridden.assign(m.nParameters, 0);
     m.startScratch.assign(3 * size_t{m.nVariables}, 0.0);

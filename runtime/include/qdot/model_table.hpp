@@ -1,47 +1,46 @@
 // fillModelTable: the descriptive half of a QdotModel (name, sizes, variable/parameter/output/
-// invariant names, id vector, Jacobian pattern) filled from a backend's module. Shared by the
-// bytecode VM and the LLVM JIT (and the standalone executables after them), so they cannot drift.
-// `Module` is any type with the fields used below (bc::Module and kernel::KernelModule have them).
+// invariant names, id vector, Jacobian pattern) pointed at a ModelDescription. Shared by the
+// bytecode VM, the LLVM JIT and the standalone executables, so they cannot drift.
 #pragma once
 
 #include <string>
 #include <vector>
 
 #include "qdot/model_abi.h"
+#include "qdot/model_description.hpp"
 
 namespace qdot {
 
-/// The C-string arrays a QdotModel points into; lives beside the model (and its module).
+/// The C-string arrays a QdotModel points into; lives beside the model (and its description).
 struct ModelNameTable {
   std::vector<const char*> variables, parameters, parameterDescriptions, outputs, invariants;
 };
 
-/// Points `m` at the names and pattern of `module`, which (like `names`) must outlive `m`.
-template <class Module>
-void fillModelTable(QdotModel& m, ModelNameTable& names, const Module& module) {
+/// Points `m` at the names and pattern of `d`, which (like `names`) must outlive `m`.
+inline void fillModelTable(QdotModel& m, ModelNameTable& names, const ModelDescription& d) {
   auto cStrings = [](const std::vector<std::string>& strings) {
     std::vector<const char*> out;
     out.reserve(strings.size());
     for (const auto& s : strings) out.push_back(s.c_str());
     return out;
   };
-  names = {cStrings(module.variableNames), cStrings(module.parameterNames), cStrings(module.parameterDescriptions),
-           cStrings(module.outputNames), cStrings(module.invariantNames)};
+  names = {cStrings(d.variableNames), cStrings(d.parameterNames), cStrings(d.parameterDescriptions),
+           cStrings(d.outputNames), cStrings(d.invariantNames)};
   m.abiVersion = QDOT_MODEL_ABI_VERSION;
-  m.name = module.name.c_str();
-  m.nVariables = static_cast<uint32_t>(module.variableNames.size());
-  m.nParameters = static_cast<uint32_t>(module.parameterNames.size());
-  m.nOutputs = static_cast<uint32_t>(module.outputNames.size());
-  m.nInvariants = static_cast<uint32_t>(module.invariantNames.size());
+  m.name = d.name.c_str();
+  m.nVariables = static_cast<uint32_t>(d.variableNames.size());
+  m.nParameters = static_cast<uint32_t>(d.parameterNames.size());
+  m.nOutputs = static_cast<uint32_t>(d.outputNames.size());
+  m.nInvariants = static_cast<uint32_t>(d.invariantNames.size());
   m.variableNames = names.variables.data();
-  m.isDifferential = module.isDifferential.data();
+  m.isDifferential = d.isDifferential.data();
   m.parameterNames = names.parameters.data();
   m.parameterDescriptions = names.parameterDescriptions.data();
   m.outputNames = names.outputs.data();
   m.invariantNames = names.invariants.data();
-  m.jacobianNonzeros = static_cast<uint32_t>(module.jacobianRowIndices.size());
-  m.jacobianColumnStarts = module.jacobianColumnStarts.data();
-  m.jacobianRowIndices = module.jacobianRowIndices.data();
+  m.jacobianNonzeros = static_cast<uint32_t>(d.jacobianRowIndices.size());
+  m.jacobianColumnStarts = d.jacobianColumnStarts.data();
+  m.jacobianRowIndices = d.jacobianRowIndices.data();
 }
 
 }  // namespace qdot

@@ -124,16 +124,16 @@ TEST_P(ExamplesTest, VmIsBitIdenticalToKernelInterpreter) {
   ASSERT_EQ(q->parameters(q, nullptr, nullptr, p.data()), 0);
   for (int trial = 0; trial < 20; ++trial) {
     for (size_t j = 0; j < n; ++j) y[j] = uniform(-1.5, 1.5), yp[j] = uniform(-1.5, 1.5);
-    kernel::Inputs in{.t = uniform(0, 10), .cj = uniform(1, 100), .y = y, .yp = yp, .p = p};
-    for (auto id : {kernel::ProgramId::Residual, kernel::ProgramId::Jacobian, kernel::ProgramId::Outputs,
-                    kernel::ProgramId::Invariants}) {
+    ModelCall in{.t = uniform(0, 10), .cj = uniform(1, 100), .y = y.data(), .yp = yp.data(), .p = p.data()};
+    for (auto id : {ModelProgram::Residual, ModelProgram::Jacobian, ModelProgram::Outputs,
+                    ModelProgram::Invariants}) {
       const kernel::Program& prog = m.kernel.program(id);
       vmOut.assign(prog.outputCount, 0.0), kOut.assign(prog.outputCount, 1.0);
       kernel::interpret(prog, in, kOut);
-      if (id == kernel::ProgramId::Residual) q->residual(q, in.t, y.data(), yp.data(), p.data(), vmOut.data());
-      if (id == kernel::ProgramId::Jacobian) q->jacobian(q, in.t, y.data(), yp.data(), p.data(), in.cj, vmOut.data());
-      if (id == kernel::ProgramId::Outputs) q->outputs(q, in.t, y.data(), yp.data(), p.data(), vmOut.data());
-      if (id == kernel::ProgramId::Invariants) q->invariants(q, in.t, y.data(), yp.data(), p.data(), vmOut.data());
+      if (id == ModelProgram::Residual) q->residual(q, in.t, y.data(), yp.data(), p.data(), vmOut.data());
+      if (id == ModelProgram::Jacobian) q->jacobian(q, in.t, y.data(), yp.data(), p.data(), in.cj, vmOut.data());
+      if (id == ModelProgram::Outputs) q->outputs(q, in.t, y.data(), yp.data(), p.data(), vmOut.data());
+      if (id == ModelProgram::Invariants) q->invariants(q, in.t, y.data(), yp.data(), p.data(), vmOut.data());
       for (size_t i = 0; i < vmOut.size(); ++i) EXPECT_EQ(ulpDistance(vmOut[i], kOut[i]), 0u) << prog.name << " " << i;
     }
   }

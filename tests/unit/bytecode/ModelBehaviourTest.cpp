@@ -181,30 +181,30 @@ TEST(Serialization, RoundTripGivesTheSameModuleAndResults) {
   SourceModel m("nlink.qd", readFile(std::string(QDOT_SOURCE_DIR) + "/examples/pendulum/nlink.qd"));
   ASSERT_TRUE(m.ok());
   std::vector<uint8_t> bytes = bc::serialize(m.module);
-  bc::Module back;
-  std::string error;
-  ASSERT_TRUE(bc::deserialize(bytes, back, error)) << error;
+  Result<bc::Module> read = bc::deserialize(bytes);
+  ASSERT_TRUE(read.ok()) << read.error();
+  const bc::Module& back = read.value();
   EXPECT_EQ(bc::serialize(back), bytes);
   std::ostringstream a, b;
   vm::disassemble(a, m.module);
   vm::disassemble(b, back);
   EXPECT_EQ(a.str(), b.str());
-  QdotModel* q2 = vm::createModelFromBytes(bytes, error);
-  ASSERT_NE(q2, nullptr) << error;
+  Result<ModelPtr> model2 = vm::createModelFromBytes(bytes);
+  ASSERT_TRUE(model2.ok()) << model2.error();
+  QdotModel* q2 = model2->get();
   const QdotModel* q = m.model;
   State s1(q), s2(q2);
   for (size_t j = 0; j < s1.y.size(); ++j) s1.y[j] = s2.y[j] = 0.1 * j, s1.yp[j] = s2.yp[j] = -0.05 * j;
   q->residual(q, 0.5, s1.y.data(), s1.yp.data(), s1.p.data(), s1.F.data());
   q2->residual(q2, 0.5, s2.y.data(), s2.yp.data(), s2.p.data(), s2.F.data());
   EXPECT_EQ(s1.F, s2.F);
-  q2->destroy(q2);
 }
 
 TEST(Emitter, RegistersAreReused) {
   SourceModel m("nlink.qd", readFile(std::string(QDOT_SOURCE_DIR) + "/examples/pendulum/nlink.qd"));
   ASSERT_TRUE(m.ok());
-  const auto& k = m.kernel.program(kernel::ProgramId::Jacobian);
-  const auto& f = m.module.function(bc::FunctionId::Jacobian);
+  const auto& k = m.kernel.program(ModelProgram::Jacobian);
+  const auto& f = m.module.function(ModelProgram::Jacobian);
   EXPECT_LT(f.registerCount * 4, k.code.size()) << f.registerCount << " registers for " << k.code.size()
                                                 << " kernel values";
 }

@@ -30,14 +30,11 @@ class SourceModel : public SourceDae {
     if (!dae) return;
     kernel = kernel::buildKernels(*dae, ctx);
     module = bytecode::emitBytecode(kernel, sources);
-    std::string error;
-    model = vm::createModel(module, error);
-    EXPECT_NE(model, nullptr) << error;
+    Result<ModelPtr> created = vm::createModel(module);
+    EXPECT_TRUE(created.ok()) << created.error();
+    if (created) owned = std::move(created).value(), model = owned.get();
   }
   SourceModel(const SourceModel&) = delete;
-  ~SourceModel() {
-    if (model) model->destroy(model);
-  }
   bool ok() const { return model != nullptr; }
 
   /// Symbol values for sym::evaluate: y, y', p and time set, everything else NaN.
@@ -55,7 +52,8 @@ class SourceModel : public SourceDae {
 
   kernel::KernelModule kernel;
   bc::Module module;
-  QdotModel* model = nullptr;
+  ModelPtr owned;
+  QdotModel* model = nullptr;  ///< owned.get()
 };
 
 /// Distance in units in the last place (0 for equal values, huge for NaN against a number).

@@ -11,9 +11,9 @@ namespace qdot::test {
 namespace {
 
 using ::testing::HasSubstr;
-using kernel::ProgramId;
 
-std::string text(const kernel::KernelModule& m, ProgramId id) {
+
+std::string text(const kernel::KernelModule& m, ModelProgram id) {
   std::ostringstream os;
   kernel::printProgram(os, m.program(id), m);
   return os.str();
@@ -29,7 +29,7 @@ TEST(Kernel, TinyResidualIsExact) {
   TinyDae d;
   kernel::KernelModule m = kernel::buildKernels(d.dae, d.ctx);
   EXPECT_TRUE(m.errors.empty());
-  EXPECT_EQ(text(m, ProgramId::Residual), R"(
+  EXPECT_EQ(text(m, ModelProgram::Residual), R"(
 function residual: 2 outputs, 12 instructions, 0 constants
   ; equation 1 (Euler-Lagrange equation of x)
   %0 = ldy 1 (der(x))
@@ -53,10 +53,10 @@ function residual: 2 outputs, 12 instructions, 0 constants
 TEST(Kernel, TinyJacobianIsExactAndSharesCse) {
   TinyDae d;
   kernel::KernelModule m = kernel::buildKernels(d.dae, d.ctx);
-  EXPECT_EQ(m.jacobianColumnStarts, (std::vector<int32_t>{0, 2, 4}));
-  EXPECT_EQ(m.jacobianRowIndices, (std::vector<int32_t>{0, 1, 0, 1}));
+  EXPECT_EQ(m.description.jacobianColumnStarts, (std::vector<int32_t>{0, 2, 4}));
+  EXPECT_EQ(m.description.jacobianRowIndices, (std::vector<int32_t>{0, 1, 0, 1}));
   EXPECT_EQ(m.sharedTemporaries, 1u);
-  EXPECT_EQ(text(m, ProgramId::Jacobian), R"(
+  EXPECT_EQ(text(m, ModelProgram::Jacobian), R"(
 function jacobian: 4 outputs, 14 instructions, 1 constants
   ; equation 1 (Euler-Lagrange equation of x)
   %0 = ldy 1 (der(x))
@@ -77,19 +77,19 @@ function jacobian: 4 outputs, 14 instructions, 1 constants
   %12 = ldk -1
   st out[3], %12
 )");
-  EXPECT_EQ(count(m.program(ProgramId::Residual), kernel::Op::Sin), 1u);
-  EXPECT_EQ(count(m.program(ProgramId::Jacobian), kernel::Op::Sin), 1u);
-  EXPECT_EQ(count(m.program(ProgramId::Residual), kernel::Op::Cos), 0u);  // Jacobian-only work stays out
+  EXPECT_EQ(count(m.program(ModelProgram::Residual), kernel::Op::Sin), 1u);
+  EXPECT_EQ(count(m.program(ModelProgram::Jacobian), kernel::Op::Sin), 1u);
+  EXPECT_EQ(count(m.program(ModelProgram::Residual), kernel::Op::Cos), 0u);  // Jacobian-only work stays out
 }
 
 TEST(Kernel, ResidualAndJacobianValues) {
   TinyDae d;
   kernel::KernelModule m = kernel::buildKernels(d.dae, d.ctx);
   std::vector<double> y = {0.3, -1.2}, yp = {0.7, 2.5}, p = {3.0, 1.5}, F(2), J(4);
-  kernel::interpret(m.program(ProgramId::Residual), {.t = 0, .cj = 0, .y = y, .yp = yp, .p = p}, F);
+  kernel::interpret(m.program(ModelProgram::Residual), {.t = 0, .cj = 0, .y = y.data(), .yp = yp.data(), .p = p.data()}, F);
   EXPECT_EQ(F[0], -1.2 * std::sin(0.3) + 2.5 * 1.5);
   EXPECT_EQ(F[1], 0.7 - -1.2);
-  kernel::interpret(m.program(ProgramId::Jacobian), {.t = 0, .cj = 40, .y = y, .yp = yp, .p = p}, J);
+  kernel::interpret(m.program(ModelProgram::Jacobian), {.t = 0, .cj = 40, .y = y.data(), .yp = yp.data(), .p = p.data()}, J);
   EXPECT_EQ(J, (std::vector<double>{-1.2 * std::cos(0.3), 40, std::sin(0.3) + 1.5 * 40, -1}));
 }
 
@@ -97,10 +97,10 @@ TEST(Kernel, ResidualAndJacobianValues) {
 TEST(Kernel, ParameterBindingsInDependencyOrderWithOverrides) {
   TinyDae d;
   kernel::KernelModule m = kernel::buildKernels(d.dae, d.ctx);
-  const kernel::Program& prog = m.program(ProgramId::Parameters);
+  const kernel::Program& prog = m.program(ModelProgram::Parameters);
   std::vector<double> p(2), given = {0, 0};
   std::vector<uint8_t> overridden = {0, 0};
-  auto run = [&] { kernel::interpret(prog, {.given = given, .overridden = overridden}, p); };
+  auto run = [&] { kernel::interpret(prog, {.given = given.data(), .overridden = overridden.data()}, p); };
   run();
   EXPECT_EQ(p, (std::vector<double>{3.0, 1.5}));
   given[1] = 2, overridden[1] = 1;
@@ -124,10 +124,10 @@ TEST(Kernel, StartValuesNominalsAndFixedFlags) {
   d.dae.variables[0].nominal = d.ctx.constant(4);
   kernel::KernelModule m = kernel::buildKernels(d.dae, d.ctx);
   std::vector<double> p = {3.0, 1.5}, out(6);
-  kernel::interpret(m.program(ProgramId::InitialValues), {.p = p}, out);
+  kernel::interpret(m.program(ModelProgram::InitialValues), {.p = p.data()}, out);
   EXPECT_EQ(out, (std::vector<double>{1.5, 0, 0, 0, 4, 0}));  // y0 = (k/2, 0), yp0 = 0, nominal = (4, 0)
-  EXPECT_EQ(m.fixed, (std::vector<int32_t>{1, 1}));
-  EXPECT_EQ(m.isDifferential, (std::vector<int32_t>{1, 1}));
+  EXPECT_EQ(m.description.fixed, (std::vector<int32_t>{1, 1}));
+  EXPECT_EQ(m.description.isDifferential, (std::vector<int32_t>{1, 1}));
 }
 
 TEST(Kernel, ExplicitInitialEquationsSetStarts) {
@@ -145,7 +145,7 @@ TEST(Kernel, ExplicitInitialEquationsSetStarts) {
   ASSERT_EQ(m.errors.size(), 1u);
   EXPECT_THAT(m.errors[0], HasSubstr("initial equation 3"));
   std::vector<double> p = {3.0, 1.5}, out(6);
-  kernel::interpret(m.program(ProgramId::InitialValues), {.p = p}, out);
+  kernel::interpret(m.program(ModelProgram::InitialValues), {.p = p.data()}, out);
   EXPECT_EQ(out, (std::vector<double>{1.5, 3.0, 0, 5.0, 0, 0}));
 }
 
@@ -164,7 +164,7 @@ TEST(Kernel, EverySourceIsLabelled) {
   kernel::KernelModule m = kernel::buildKernels(d.dae, d.ctx);
   for (const kernel::Program& p : m.programs)
     for (const kernel::Instr& ins : p.code) {
-      if (ins.source == UINT32_MAX && &p == &m.program(ProgramId::InitialValues)) continue;
+      if (ins.source == UINT32_MAX && &p == &m.program(ModelProgram::InitialValues)) continue;
       ASSERT_LT(ins.source, m.sources.size()) << p.name;
       EXPECT_FALSE(m.sources[ins.source].label.empty());
     }

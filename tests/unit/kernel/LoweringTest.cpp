@@ -36,7 +36,7 @@ class Lowering : public ::testing::Test {
   }
   double run(Expr e, double xv, double yv, double zv) {
     std::vector<double> in = {xv, yv, zv}, out(1);
-    kernel::interpret(lower(e), {.y = in}, out);
+    kernel::interpret(lower(e), {.y = in.data()}, out);
     return out[0];
   }
   double reference(Expr e, double xv, double yv, double zv) {

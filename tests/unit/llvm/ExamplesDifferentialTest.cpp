@@ -43,7 +43,7 @@ class JitExamplesTest : public ::testing::TestWithParam<std::tuple<std::string, 
   uint64_t maxUlps = 0;
 
   // Runs the reference interpreter and compares all of `jit` with it.
-  void compare(const KernelSource& m, kernel::ProgramId id, const kernel::Inputs& in, const std::vector<double>& jit,
+  void compare(const KernelSource& m, ModelProgram id, const ModelCall& in, const std::vector<double>& jit,
                int rc, const std::string& what) {
     const kernel::Program& prog = m.kernel.program(id);
     std::vector<double> ref(prog.outputCount);
@@ -70,18 +70,18 @@ TEST_P(JitExamplesTest, AgreesWithTheKernelInterpreter) {
   const QdotModel* q = m.model;
   size_t n = q->nVariables, np = q->nParameters;
   EXPECT_EQ(q->abiVersion, uint32_t(QDOT_MODEL_ABI_VERSION));
-  EXPECT_EQ(q->jacobianNonzeros, m.kernel.jacobianRowIndices.size());
+  EXPECT_EQ(q->jacobianNonzeros, m.kernel.description.jacobianRowIndices.size());
 
   // Parameters: defaults, then some overridden with random values.
   std::vector<double> p(np), given = randoms(np, 0.5, 2.0);
   std::vector<uint8_t> none(np, 0), some(np);
   for (size_t i = 0; i < np; ++i) some[i] = i % 2;
-  kernel::Inputs pin;
-  pin.given = given, pin.overridden = none;
-  compare(m, kernel::ProgramId::Parameters, pin, p, q->parameters(q, given.data(), none.data(), p.data()), "p");
+  ModelCall pin;
+  pin.given = given.data(), pin.overridden = none.data();
+  compare(m, ModelProgram::Parameters, pin, p, q->parameters(q, given.data(), none.data(), p.data()), "p");
   std::vector<double> p2(np);
-  pin.overridden = some;
-  compare(m, kernel::ProgramId::Parameters, pin, p2, q->parameters(q, given.data(), some.data(), p2.data()), "p'");
+  pin.overridden = some.data();
+  compare(m, ModelProgram::Parameters, pin, p2, q->parameters(q, given.data(), some.data(), p2.data()), "p'");
 
   // Start values.
   std::vector<double> y0(n), yp0(n), nominal(n), start;
@@ -89,22 +89,22 @@ TEST_P(JitExamplesTest, AgreesWithTheKernelInterpreter) {
   start.insert(start.end(), y0.begin(), y0.end());
   start.insert(start.end(), yp0.begin(), yp0.end());
   start.insert(start.end(), nominal.begin(), nominal.end());
-  kernel::Inputs sin;
-  sin.t = 0.25, sin.p = p;
-  compare(m, kernel::ProgramId::InitialValues, sin, start, rc, "start");
+  ModelCall sin;
+  sin.t = 0.25, sin.p = p.data();
+  compare(m, ModelProgram::InitialValues, sin, start, rc, "start");
 
   // State functions at random states.
   for (int trial = 0; trial < 8; ++trial) {
     std::vector<double> y = randoms(n, -1.5, 1.5), yp = randoms(n, -2, 2), F(n), J(q->jacobianNonzeros);
     std::vector<double> out(q->nOutputs), inv(q->nInvariants);
     double t = uniform(0, 10), cj = uniform(0.1, 100);
-    kernel::Inputs in;
-    in.t = t, in.cj = cj, in.y = y, in.yp = yp, in.p = p;
-    compare(m, kernel::ProgramId::Residual, in, F, q->residual(q, t, y.data(), yp.data(), p.data(), F.data()), "F");
-    compare(m, kernel::ProgramId::Jacobian, in, J,
+    ModelCall in;
+    in.t = t, in.cj = cj, in.y = y.data(), in.yp = yp.data(), in.p = p.data();
+    compare(m, ModelProgram::Residual, in, F, q->residual(q, t, y.data(), yp.data(), p.data(), F.data()), "F");
+    compare(m, ModelProgram::Jacobian, in, J,
             q->jacobian(q, t, y.data(), yp.data(), p.data(), cj, J.data()), "J");
-    compare(m, kernel::ProgramId::Outputs, in, out, q->outputs(q, t, y.data(), yp.data(), p.data(), out.data()), "out");
-    compare(m, kernel::ProgramId::Invariants, in, inv,
+    compare(m, ModelProgram::Outputs, in, out, q->outputs(q, t, y.data(), yp.data(), p.data(), out.data()), "out");
+    compare(m, ModelProgram::Invariants, in, inv,
             q->invariants(q, t, y.data(), yp.data(), p.data(), inv.data()), "inv");
   }
   std::cout << "[ ulps ] " << std::filesystem::path(file).filename().string() << " O" << variant.optLevel

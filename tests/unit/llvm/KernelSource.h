@@ -26,19 +26,17 @@ class KernelSource : public SourceDae {
     if (!dae) return;
     kernel = kernel::buildKernels(*dae, ctx);
     options.verifyIR = true;
-    std::string error;
-    model = llvmbackend::createJitModel(kernel, sources, options, error, &stats);
-    EXPECT_NE(model, nullptr) << error;
+    Result<ModelPtr> created = llvmbackend::createJitModel(kernel, sources, options, &stats);
+    EXPECT_TRUE(created.ok()) << created.error();
+    if (created) owned = std::move(created).value(), model = owned.get();
   }
   KernelSource(const KernelSource&) = delete;
-  ~KernelSource() {
-    if (model) model->destroy(model);
-  }
   bool ok() const { return model != nullptr; }
 
   kernel::KernelModule kernel;
   llvmbackend::JitStats stats;
-  QdotModel* model = nullptr;
+  ModelPtr owned;
+  QdotModel* model = nullptr;  ///< owned.get()
 };
 
 /// Distance in units in the last place (0 for equal values or two NaNs, huge for NaN against a number).

@@ -41,15 +41,16 @@ kernel::KernelModule opcodeModule() {
   res.outputCount = static_cast<uint32_t>(results.size());
 
   kernel::KernelModule m;
-  m.name = "Opcodes";
+  ModelDescription& d = m.description;
+  d.name = "Opcodes";
   size_t n = results.size();
-  for (size_t i = 0; i < n; ++i) m.variableNames.push_back("v" + std::to_string(i));
-  m.isDifferential.assign(n, 0);
-  m.fixed.assign(n, 0);
-  m.jacobianColumnStarts.assign(n + 1, 0);
-  m.parameterNames = {"a", "b"};
-  m.parameterDescriptions = {"", ""};
-  kernel::Program& params = m.program(kernel::ProgramId::Parameters);
+  for (size_t i = 0; i < n; ++i) d.variableNames.push_back("v" + std::to_string(i));
+  d.isDifferential.assign(n, 0);
+  d.fixed.assign(n, 0);
+  d.jacobianColumnStarts.assign(n + 1, 0);
+  d.parameterNames = {"a", "b"};
+  d.parameterDescriptions = {"", ""};
+  kernel::Program& params = m.program(ModelProgram::Parameters);
   params.name = "parameters";
   params.code = {Instr{Op::LoadOverridden, 0, 0, 0, 0}, Instr{Op::LoadGiven, 0, 0, 0, 0},
                  Instr{Op::LoadConst, 0, 0, 0, 0},      Instr{Op::Select, 0, 1, 2, 0},
@@ -57,8 +58,8 @@ kernel::KernelModule opcodeModule() {
                  Instr{Op::Store, 5, 0, 0, 1}};
   params.constants = {7.0};
   params.outputCount = 2;
-  m.program(kernel::ProgramId::InitialValues).outputCount = static_cast<uint32_t>(3 * n);
-  m.program(kernel::ProgramId::Residual) = res;
+  m.program(ModelProgram::InitialValues).outputCount = static_cast<uint32_t>(3 * n);
+  m.program(ModelProgram::Residual) = res;
   return m;
 }
 
@@ -69,11 +70,11 @@ void checkEveryOpcode(int optLevel, uint32_t split) {
   options.optLevel = options.jacobianOptLevel = options.coldOptLevel = optLevel;
   options.compiledPrograms = llvmbackend::kAllPrograms;  // the parameters program has ldgiven/ldover
   options.maxInstructionsPerFunction = split;
-  std::string error;
-  QdotModel* q = llvmbackend::createJitModel(k, sm, options, error);
-  ASSERT_NE(q, nullptr) << error;
+  Result<ModelPtr> model = llvmbackend::createJitModel(k, sm, options);
+  ASSERT_TRUE(model.ok()) << model.error();
+  QdotModel* q = model->get();
   size_t n = q->nVariables;
-  const kernel::Program& res = k.program(kernel::ProgramId::Residual);
+  const kernel::Program& res = k.program(ModelProgram::Residual);
   std::vector<double> p = {1.25, -4.0}, yp(n, 0.0), F(n), ref(n), y(n, 0.0);
   yp[1] = -0.0;
   size_t mismatches = 0;
@@ -81,8 +82,8 @@ void checkEveryOpcode(int optLevel, uint32_t split) {
     for (double b : kValues) {
       y[0] = a, y[1] = b, y[2] = a == b ? 0.0 : 1.0;
       q->residual(q, 3.5, y.data(), yp.data(), p.data(), F.data());
-      kernel::Inputs in;
-      in.t = 3.5, in.y = y, in.yp = yp, in.p = p;
+      ModelCall in;
+      in.t = 3.5, in.y = y.data(), in.yp = yp.data(), in.p = p.data();
       kernel::interpret(res, in, ref);
       for (size_t i = 0; i < n; ++i)
         if (!sameBits(F[i], ref[i]) && ++mismatches < 20)
@@ -101,7 +102,6 @@ void checkEveryOpcode(int optLevel, uint32_t split) {
   q->parameters(q, given.data(), flags.data(), out.data());
   EXPECT_EQ(out[0], 7.0);
   EXPECT_EQ(out[1], 1.0);
-  q->destroy(q);
 }
 
 TEST(JitOpcodes, EveryOpcodeMatchesTheInterpreterBitForBitAtO2) { checkEveryOpcode(2, 5000); }

@@ -21,7 +21,7 @@ TEST(JitSplit, BigChainSplitsIntoSeveralFunctionsAndAgrees) {
   ASSERT_TRUE(m.ok());
   const QdotModel* q = m.model;
   ASSERT_EQ(q->nVariables, 2000u);  // x and der(x)
-  const auto& res = m.kernel.program(kernel::ProgramId::Residual);
+  const auto& res = m.kernel.program(ModelProgram::Residual);
   EXPECT_GT(res.code.size(), 5000u);
   EXPECT_EQ(m.stats.functions[2], (res.code.size() + 999) / 1000);
   EXPECT_GT(m.stats.functions[3], 1u);
@@ -39,10 +39,10 @@ TEST(JitSplit, BigChainSplitsIntoSeveralFunctionsAndAgrees) {
   for (double& x : yp) x = u(rng);
   ASSERT_EQ(q->residual(q, 0.5, y.data(), yp.data(), p.data(), F.data()), 0) << q->lastError(q);
   ASSERT_EQ(q->jacobian(q, 0.5, y.data(), yp.data(), p.data(), 20.0, J.data()), 0) << q->lastError(q);
-  kernel::Inputs in;
-  in.t = 0.5, in.cj = 20.0, in.y = y, in.yp = yp, in.p = p;
+  ModelCall in;
+  in.t = 0.5, in.cj = 20.0, in.y = y.data(), in.yp = yp.data(), in.p = p.data();
   kernel::interpret(res, in, ref);
-  kernel::interpret(m.kernel.program(kernel::ProgramId::Jacobian), in, refJ);
+  kernel::interpret(m.kernel.program(ModelProgram::Jacobian), in, refJ);
   for (size_t i = 0; i < n; ++i) ASSERT_TRUE(sameBits(F[i], ref[i])) << i << ": " << F[i] << " vs " << ref[i];
   for (size_t i = 0; i < J.size(); ++i) ASSERT_TRUE(sameBits(J[i], refJ[i])) << i;
 }
@@ -72,9 +72,9 @@ TEST(JitUnits, DefaultPlanOnOneOrFourThreadsAgrees) {
     EXPECT_EQ(y0[299], 0.01 * 300);  // x[300] starts at 0.01*300
     for (size_t i = 0; i < n; ++i) yp0[i] = 0.001 * double(i);
     ASSERT_EQ(q->residual(q, 0.5, y0.data(), yp0.data(), p.data(), F.data()), 0);
-    kernel::Inputs in;
-    in.t = 0.5, in.y = y0, in.yp = yp0, in.p = p;
-    kernel::interpret(m.kernel.program(kernel::ProgramId::Residual), in, ref);
+    ModelCall in;
+    in.t = 0.5, in.y = y0.data(), in.yp = yp0.data(), in.p = p.data();
+    kernel::interpret(m.kernel.program(ModelProgram::Residual), in, ref);
     for (size_t i = 0; i < n; ++i) ASSERT_TRUE(sameBits(F[i], ref[i])) << threads << " threads, F[" << i << "]";
   }
 }

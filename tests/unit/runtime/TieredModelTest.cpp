@@ -21,7 +21,7 @@ struct StandIn : QdotModel {
   std::atomic<int>* destroyed = nullptr;
 };
 
-QdotModel* standIn(double value, std::atomic<int>* destroyed) {
+ModelPtr standIn(double value, std::atomic<int>* destroyed) {
   auto* m = new StandIn();
   m->abiVersion = QDOT_MODEL_ABI_VERSION;
   m->nVariables = 1;
@@ -38,7 +38,7 @@ QdotModel* standIn(double value, std::atomic<int>* destroyed) {
     ++*self->destroyed;
     delete self;
   };
-  return m;
+  return ModelPtr(m);
 }
 
 double residualOf(const QdotModel* m) {
@@ -51,10 +51,11 @@ TEST(TieredModel, RunsTheFirstTierUntilTheSecondIsReadyThenTheSecond) {
   std::atomic<int> destroyed{0};
   std::promise<void> release;
   std::shared_future<void> released = release.get_future().share();
-  QdotModel* m = createTieredModel(standIn(1.0, &destroyed), [&, released](const std::atomic<bool>&) {
+  ModelPtr tiered = createTieredModel(standIn(1.0, &destroyed), [&, released](const std::atomic<bool>&) {
     released.wait();
     return standIn(2.0, &destroyed);
   });
+  QdotModel* m = tiered.get();
   EXPECT_EQ(m->nVariables, 1u);  // the first tier's table
   EXPECT_EQ(residualOf(m), 1.0);
   EXPECT_EQ(residualOf(m), 1.0);
@@ -71,45 +72,46 @@ TEST(TieredModel, RunsTheFirstTierUntilTheSecondIsReadyThenTheSecond) {
   EXPECT_FALSE(report->compiling);
   EXPECT_GE(report->firstTierCalls, 2u);
   EXPECT_GE(report->secondTierCalls, 2u);
-  m->destroy(m);
+  tiered.reset();
   EXPECT_EQ(destroyed.load(), 2);
 }
 
 TEST(TieredModel, DestroyCancelsACompileStillRunning) {
   std::atomic<int> destroyed{0};
   std::atomic<bool> sawCancel{false};
-  QdotModel* m = createTieredModel(standIn(1.0, &destroyed), [&](const std::atomic<bool>& cancel) -> QdotModel* {
+  ModelPtr tiered = createTieredModel(standIn(1.0, &destroyed), [&](const std::atomic<bool>& cancel) -> ModelPtr {
     while (!cancel.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     sawCancel = true;
     return nullptr;  // gave up
   });
+  QdotModel* m = tiered.get();
   EXPECT_EQ(residualOf(m), 1.0);
   std::optional<TierReport> report = tierReport(m);
   ASSERT_TRUE(report.has_value());
   EXPECT_FALSE(report->ready);
   EXPECT_TRUE(report->compiling);
   EXPECT_EQ(report->firstTierCalls, 1u);
-  m->destroy(m);
+  tiered.reset();
   EXPECT_TRUE(sawCancel.load());
   EXPECT_EQ(destroyed.load(), 1);
 }
 
 TEST(TieredModel, ASecondTierFinishedAfterTheRunIsReleasedUnused) {
   std::atomic<int> destroyed{0};
-  QdotModel* m = createTieredModel(standIn(1.0, &destroyed), [&](const std::atomic<bool>& cancel) {
+  ModelPtr tiered = createTieredModel(standIn(1.0, &destroyed), [&](const std::atomic<bool>& cancel) {
     while (!cancel.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     return standIn(2.0, &destroyed);  // finished anyway
   });
+  QdotModel* m = tiered.get();
   EXPECT_EQ(residualOf(m), 1.0);
-  m->destroy(m);
+  tiered.reset();
   EXPECT_EQ(destroyed.load(), 2);
 }
 
 TEST(TieredModel, ReportIsOnlyForTieredModels) {
   std::atomic<int> destroyed{0};
-  QdotModel* plain = standIn(1.0, &destroyed);
-  EXPECT_FALSE(tierReport(plain).has_value());
-  plain->destroy(plain);
+  ModelPtr plain = standIn(1.0, &destroyed);
+  EXPECT_FALSE(tierReport(plain.get()).has_value());
 }
 
 }  // namespace

@@ -36,24 +36,25 @@ class Assembler {
 inline bc::Module tinyModule() {
   using bc::Opcode;
   bc::Module m;
-  m.name = "Tiny";
-  m.variableNames = {"x"}, m.parameterNames = {"a"}, m.parameterDescriptions = {"a parameter"};
-  m.isDifferential = {1}, m.fixed = {1};
-  m.jacobianColumnStarts = {0, 1}, m.jacobianRowIndices = {0};
+  ModelDescription& d = m.description;
+  d.name = "Tiny";
+  d.variableNames = {"x"}, d.parameterNames = {"a"}, d.parameterDescriptions = {"a parameter"};
+  d.isDifferential = {1}, d.fixed = {1};
+  d.jacobianColumnStarts = {0, 1}, d.jacobianRowIndices = {0};
   m.locations = {{"equation 1", "tiny.qd:3", "der(x) = a*x"}};
-  Assembler p(m.function(bc::FunctionId::Parameters), {}, 1);
+  Assembler p(m.function(ModelProgram::Parameters), {}, 1);
   p.op(Opcode::LoadGiven, {p.r(0), 0}).op(Opcode::Store, {0, p.r(0)}).ret(1);
-  Assembler s(m.function(bc::FunctionId::InitialValues), {1.0, 0.0}, 0);
+  Assembler s(m.function(ModelProgram::InitialValues), {1.0, 0.0}, 0);
   s.op(Opcode::Store, {0, 0}).op(Opcode::Store, {1, 1}).op(Opcode::Store, {2, 1}).ret(3);
-  Assembler f(m.function(bc::FunctionId::Residual), {}, 2);  // F = x' - a*x
+  Assembler f(m.function(ModelProgram::Residual), {}, 2);  // F = x' - a*x
   f.op(Opcode::LoadP, {f.r(1), 0}, 0).op(Opcode::LoadY, {f.r(0), 0}, 0).op(Opcode::Mul, {f.r(1), f.r(1), f.r(0)}, 0);
   f.op(Opcode::LoadYp, {f.r(0), 0}, 0).op(Opcode::Sub, {f.r(0), f.r(0), f.r(1)}, 0).op(Opcode::Store, {0, f.r(0)}, 0);
   f.ret(1);
-  Assembler j(m.function(bc::FunctionId::Jacobian), {}, 2);  // J = cj - a
+  Assembler j(m.function(ModelProgram::Jacobian), {}, 2);  // J = cj - a
   j.op(Opcode::LoadCj, {j.r(0)}).op(Opcode::LoadP, {j.r(1), 0}).op(Opcode::Sub, {j.r(0), j.r(0), j.r(1)});
   j.op(Opcode::Store, {0, j.r(0)}).ret(1);
-  Assembler(m.function(bc::FunctionId::Outputs), {}, 0).ret(0);
-  Assembler(m.function(bc::FunctionId::Invariants), {}, 0).ret(0);
+  Assembler(m.function(ModelProgram::Outputs), {}, 0).ret(0);
+  Assembler(m.function(ModelProgram::Invariants), {}, 0).ret(0);
   return m;
 }
 

@@ -38,7 +38,7 @@ struct EveryOpcode {
   uint32_t outputs = 0;
 
   EveryOpcode() {
-    bc::Function& f = module.function(bc::FunctionId::Jacobian);
+    bc::Function& f = module.function(ModelProgram::Jacobian);
     Assembler a(f, {0.75, -1.5, 2.0}, bc::kOpcodeCount);
     uint32_t next = a.r(0);
     for (uint32_t i = 0; i < bc::kOpcodeCount; ++i) {
@@ -63,7 +63,7 @@ struct EveryOpcode {
 TEST(OpcodeTable, DisassemblerPrintsEveryOpcode) {
   EveryOpcode m;
   std::ostringstream os;
-  vm::disassembleFunction(os, m.module, bc::FunctionId::Jacobian);
+  vm::disassembleFunction(os, m.module, ModelProgram::Jacobian);
   std::string text = os.str();
   size_t at = 0;
   for (uint32_t i = 0; i < bc::kOpcodeCount; ++i) {
@@ -79,13 +79,13 @@ TEST(OpcodeTable, DisassemblerPrintsEveryOpcode) {
 
 TEST(Dispatch, ComputedGotoAndSwitchAgreeOnEveryOpcode) {
   EveryOpcode m;
-  const bc::Function& f = m.module.function(bc::FunctionId::Jacobian);
+  const bc::Function& f = m.module.function(ModelProgram::Jacobian);
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> u(-2, 2);
   for (int trial = 0; trial < 200; ++trial) {
     double y[] = {u(rng)}, yp[] = {u(rng)}, p[] = {u(rng)}, given[] = {u(rng)};
     uint8_t overridden[] = {static_cast<uint8_t>(trial % 2)};
-    vm::Inputs in{.t = u(rng), .cj = u(rng), .y = y, .yp = yp, .p = p, .given = given, .overridden = overridden};
+    ModelCall in{.t = u(rng), .cj = u(rng), .y = y, .yp = yp, .p = p, .given = given, .overridden = overridden};
     std::vector<double> r1 = vm::makeRegisters(f), r2 = r1, o1(m.outputs), o2(m.outputs);
     r1[0] = r2[0] = u(rng), r1[1] = r2[1] = u(rng);  // vary the operands of the computing opcodes
     vm::execute(f, r1.data(), in, o1.data());
@@ -97,7 +97,7 @@ TEST(Dispatch, ComputedGotoAndSwitchAgreeOnEveryOpcode) {
 // out[0] = op(a, b) computed by the VM.
 double apply(Opcode op, double a, double b = 0, uint32_t imm = 0) {
   bc::Module m = tinyModule();
-  bc::Function& f = m.function(bc::FunctionId::Jacobian);
+  bc::Function& f = m.function(ModelProgram::Jacobian);
   Assembler as(f, {a, b}, 1);
   bc::Format fmt = bc::info(op).format;
   if (fmt == bc::Format::Unary) as.op(op, {as.r(0), 0});

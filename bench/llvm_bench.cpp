@@ -83,26 +83,29 @@ int main(int argc, char** argv) {
   size_t instructions = 0;
   for (const auto& p : k.programs) instructions += p.code.size();
 
-  std::string error;
   llvmbackend::JitStats stats;
   auto t1 = Clock::now();
-  QdotModel* jit = llvmbackend::createJitModel(k, sources, options, error, &stats);
+  Result<ModelPtr> jitModel = llvmbackend::createJitModel(k, sources, options, &stats);
   double total = since(t1);
-  if (!jit) {
-    std::cerr << error << "\n";
+  if (!jitModel) {
+    std::cerr << jitModel.error() << "\n";
     return 1;
   }
   auto t2 = Clock::now();
-  bc::Module module = bytecode::emitBytecode(k, sources);
-  QdotModel* vm = vm::createModel(module, error);
+  Result<ModelPtr> vmModel = vm::createModel(bytecode::emitBytecode(k, sources));
   double vmBuild = since(t2);
+  if (!vmModel) {
+    std::cerr << vmModel.error() << "\n";
+    return 1;
+  }
+  QdotModel *jit = jitModel->get(), *vm = vmModel->get();
 
   std::vector<double> p(jit->nParameters);
   jit->parameters(jit, nullptr, nullptr, p.data());
   uint32_t functions = 0;
   for (uint32_t f : stats.functions) functions += f;
   std::cout << "n=" << (argc > 2 ? argv[2] : "-") << " O" << options.optLevel << " pipeline O" << (options.pipelineLevel >= 0 ? options.pipelineLevel : options.optLevel) << " split " << options.maxInstructionsPerFunction << " variables=" << jit->nVariables
-            << " instructions=" << instructions << " residual=" << k.program(kernel::ProgramId::Residual).code.size()
+            << " instructions=" << instructions << " residual=" << k.program(ModelProgram::Residual).code.size()
             << " functions=" << functions << " frontend=" << frontEnd << "s jit=" << total
             << "s (lower " << stats.lowerSeconds << " opt " << stats.optimiseSeconds << " codegen "
             << stats.codegenSeconds << " link " << stats.linkSeconds << ", " << stats.units << " units on " << stats.threads
@@ -111,7 +114,5 @@ int main(int argc, char** argv) {
     std::cout << " residual_ns jit=" << residualNs(jit, p) << " vm=" << residualNs(vm, p)
               << " jacobian_ns jit=" << residualNs(jit, p, true) << " vm=" << residualNs(vm, p, true);
   std::cout << "\n";
-  jit->destroy(jit);
-  vm->destroy(vm);
   return 0;
 }
