@@ -165,7 +165,7 @@ class Builder {
 
   // p_i = overridden_i ? given_i : default_i, in dependency order.
   void buildParameters() {
-    ProgramBuilder b("parameters");  // defaults see other parameters only (not time)
+    ProgramBuilder b(programName(ModelProgram::Parameters));  // defaults see other parameters only (not time)
     const double nan = std::numeric_limits<double>::quiet_NaN();
     for (uint32_t k : parameterOrder()) {
       const auto& p = dae_.parameters[k];
@@ -238,7 +238,7 @@ class Builder {
   // out = [y0 (n), yp0 (n), nominal (n)]; stores of a plain 0 serve no source.
   void buildInitialValues() {
     std::vector<Start> starts = collectStarts();
-    ProgramBuilder b("initialValues");
+    ProgramBuilder b(programName(ModelProgram::InitialValues));
     bindInputs(b, false);
     auto n = static_cast<uint32_t>(dae_.variables.size());
     auto store = [&](uint32_t slot, Expr value, uint32_t source) {
@@ -269,14 +269,14 @@ class Builder {
     m_.sharedTemporaries = cse.temporaries.size();
     size_t n = dae_.equations.size();
 
-    ProgramBuilder res("residual");
+    ProgramBuilder res(programName(ModelProgram::Residual));
     bindInputs(res, true);
     for (const auto& [t, value] : cse.temporaries) res.bindTemporary(t, value);
     for (uint32_t i = 0; i < n; ++i) res.setSource(equationSource_[i]), res.store(i, res.lower(cse.outputs[i]));
     reportUnbound(res, "residual");
     m_.program(ModelProgram::Residual) = res.finish(static_cast<uint32_t>(n));
 
-    ProgramBuilder jb("jacobian");
+    ProgramBuilder jb(programName(ModelProgram::Jacobian));
     bindInputs(jb, true, cj);
     for (const auto& [t, value] : cse.temporaries) jb.bindTemporary(t, value);
     for (uint32_t k = 0; k < jac.values.size(); ++k) {
@@ -288,13 +288,13 @@ class Builder {
 
   // --- outputs and invariants --------------------------------------------------------------------
 
-  Program buildMonitor(std::string name, const std::vector<Expr>& values, const std::vector<uint32_t>& sources) {
+  Program buildMonitor(ModelProgram program, const std::vector<Expr>& values, const std::vector<uint32_t>& sources) {
     sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, values, "$t");
-    ProgramBuilder b(name);
+    ProgramBuilder b(programName(program));
     bindInputs(b, true);
     for (const auto& [t, value] : cse.temporaries) b.bindTemporary(t, value);
     for (uint32_t i = 0; i < values.size(); ++i) b.setSource(sources[i]), b.store(i, b.lower(cse.outputs[i]));
-    reportUnbound(b, name);
+    reportUnbound(b, programName(program));
     return b.finish(static_cast<uint32_t>(values.size()));
   }
 
@@ -305,7 +305,7 @@ class Builder {
       values.push_back(o.value);
       sources.push_back(addSource("output " + o.name, o.range, o.name + " = " + sym::toString(ctx_, o.value)));
     }
-    return buildMonitor("outputs", values, sources);
+    return buildMonitor(ModelProgram::Outputs, values, sources);
   }
 
   Program buildInvariants() {
@@ -315,7 +315,7 @@ class Builder {
       values.push_back(inv.value);
       sources.push_back(addSource("invariant " + inv.name + " (" + inv.kind + ")", dae_.range));
     }
-    return buildMonitor("invariants", values, sources);
+    return buildMonitor(ModelProgram::Invariants, values, sources);
   }
 };
 
