@@ -104,7 +104,7 @@ bool checkBalance(const Dae& dae, sym::Context& ctx, DiagnosticEngine& diags) {
                           "add an equation for each of them, or make them parameters or definitions");
     for (int v : dm.underVariables)
       if (d.notes.size() < 12)
-        d.notes.push_back({dae.variables[v].declRange, "'" + dae.variables[v].name + "' is not determined by the equations"});
+        d.notes.push_back({dae.variables[v].declaration.declRange, "'" + dae.variables[v].name + "' is not determined by the equations"});
   }
   if (!dm.overEquations.empty()) {
     std::vector<int> extra;

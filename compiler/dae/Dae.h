@@ -16,28 +16,27 @@
 namespace qdot::dae {
 
 enum class VarKind { State, Algebraic };
-enum class VarRole { Coordinate, Velocity, State, Algebraic, Multiplier };
-const char* roleName(VarRole r);
+/// What an unknown of the DAE is in the mechanics (what a declaration is: flat::VarRole).
+enum class UnknownRole { Coordinate, Velocity, State, Algebraic, Multiplier };
+const char* roleName(UnknownRole r);
 
+/// An unknown of the DAE: what the DAE makes of it (kind, role, symbols, result name) and its
+/// declaration as the flat model has it (embedded, not copied field by field).
 struct Variable {
-  std::string name;
+  std::string name;  ///< result name: "x", "der(x)", "lambda[1]"
   VarKind kind = VarKind::Algebraic;
-  VarRole role = VarRole::Algebraic;
-  sym::Expr y = nullptr;   ///< the variable's symbol
+  UnknownRole role = UnknownRole::Algebraic;
+  sym::Expr y = nullptr;   ///< the variable's symbol (declaration.symbol)
   sym::Expr yp = nullptr;  ///< its time-derivative symbol (states only)
   int flatVar = -1;        ///< index in the FlatModel (-1 for multipliers)
-  SourceRange declRange;
-  sym::Expr start = nullptr;  ///< over parameters; null = no start given
-  bool fixed = false;
-  sym::Expr nominal = nullptr;
-  std::string description, unit;
+  /// declRange, start (over parameters; null = none), fixed, nominal, description, unit. A
+  /// velocity without a declared start starts at 0; a multiplier's declaration is made by buildDae
+  /// (the constraint's range, role flat::VarRole::Multiplier).
+  flat::Variable declaration;
 };
 
-struct Equation {
-  sym::Expr residual = nullptr;
-  flat::Origin origin;
-  sym::Expr lhs = nullptr, rhs = nullptr;  ///< as written, when it came from the model text
-};
+/// A DAE equation is a flat equation (residual, origin, the sides as written).
+using Equation = flat::Equation;
 
 struct Parameter {
   std::string name;

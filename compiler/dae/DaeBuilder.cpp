@@ -54,20 +54,10 @@ class Builder {
     return n;
   }
 
-  Variable fromFlat(int index, VarKind kind, VarRole role) {
+  Variable fromFlat(int index, VarKind kind, UnknownRole role) {
     const flat::Variable& f = m_.variables[index];
-    Variable v{.name = std::string(f.name),
-               .kind = kind,
-               .role = role,
-               .y = f.symbol,
-               .flatVar = index,
-               .declRange = f.declRange,
-               .start = f.start,
-               .fixed = f.fixed,
-               .nominal = f.nominal,
-               .description = std::string(f.description),
-               .unit = std::string(f.unit)};
-    return v;
+    return Variable{.name = std::string(f.name), .kind = kind, .role = role, .y = f.symbol, .flatVar = index,
+                    .declaration = f};
   }
 
   void addParameters() {
@@ -88,15 +78,15 @@ class Builder {
       const flat::Variable& v = m_.variables[q.derivative];
       dae_.coordinates.push_back(static_cast<int>(dae_.variables.size()));
       if (!row.inertial && !ctx_.dependsOn(row.residual, v.symbol)) {
-        dae_.variables.push_back(fromFlat(row.coordinate, VarKind::Algebraic, VarRole::Coordinate));
+        dae_.variables.push_back(fromFlat(row.coordinate, VarKind::Algebraic, UnknownRole::Coordinate));
         continue;
       }
-      Variable qv = fromFlat(row.coordinate, VarKind::State, VarRole::Coordinate);
+      Variable qv = fromFlat(row.coordinate, VarKind::State, UnknownRole::Coordinate);
       qv.yp = ctx_.symbol("$der(" + std::string(q.name) + ")");
       kinematic_.push_back({ctx_.sub(qv.yp, v.symbol), {flat::OriginKind::Kinematic, q.declRange, row.coordinate, ""}});
       dae_.variables.push_back(std::move(qv));
-      Variable vv = fromFlat(q.derivative, row.inertial ? VarKind::State : VarKind::Algebraic, VarRole::Velocity);
-      vv.start = v.start ? v.start : ctx_.zero();  // a velocity starts at 0 unless an initial equation says otherwise
+      Variable vv = fromFlat(q.derivative, row.inertial ? VarKind::State : VarKind::Algebraic, UnknownRole::Velocity);
+      vv.declaration.start = v.start ? v.start : ctx_.zero();  // a velocity starts at 0 unless an initial equation says otherwise
       if (row.inertial) vv.yp = m_.variables[v.derivative].symbol;
       velocities.push_back(std::move(vv));
     }
@@ -110,20 +100,22 @@ class Builder {
       const flat::Variable& f = m_.variables[i];
       if (f.role != flat::VarRole::Unknown) continue;
       if (f.derivative >= 0) {
-        Variable v = fromFlat(i, VarKind::State, VarRole::State);
+        Variable v = fromFlat(i, VarKind::State, UnknownRole::State);
         v.yp = m_.variables[f.derivative].symbol;
         dae_.variables.push_back(std::move(v));
       } else {
-        algebraic.push_back(fromFlat(i, VarKind::Algebraic, VarRole::Algebraic));
+        algebraic.push_back(fromFlat(i, VarKind::Algebraic, UnknownRole::Algebraic));
       }
     }
     dae_.variables.insert(dae_.variables.end(), std::make_move_iterator(algebraic.begin()),
                           std::make_move_iterator(algebraic.end()));
     for (const auto& mult : eom_.multipliers) {
       const auto& c = m_.constraints[mult.constraint];
-      dae_.variables.push_back({.name = mult.name, .kind = VarKind::Algebraic, .role = VarRole::Multiplier,
-                                .y = mult.symbol, .declRange = c.origin.range,
-                                .description = "Lagrange multiplier of the constraint"});
+      flat::Variable declaration{.name = ctx_.symbolName(mult.symbol), .role = flat::VarRole::Multiplier,
+                                 .symbol = mult.symbol, .declRange = c.origin.range,
+                                 .description = "Lagrange multiplier of the constraint"};
+      dae_.variables.push_back({.name = mult.name, .kind = VarKind::Algebraic, .role = UnknownRole::Multiplier,
+                                .y = mult.symbol, .declaration = declaration});
     }
   }
 
@@ -135,26 +127,26 @@ class Builder {
     }
     dae_.equations.insert(dae_.equations.end(), std::make_move_iterator(kinematic_.begin()),
                           std::make_move_iterator(kinematic_.end()));
-    for (const auto& e : m_.equations) dae_.equations.push_back({e.residual, e.origin, e.lhs, e.rhs});
+    dae_.equations.insert(dae_.equations.end(), m_.equations.begin(), m_.equations.end());
     for (size_t k = 0; k < m_.constraints.size(); ++k) {
       const auto& c = m_.constraints[k];
       flat::Origin o = c.origin;
       o.variable = static_cast<int>(k);
       dae_.equations.push_back({c.residual, o, c.lhs, c.rhs});
     }
-    for (const auto& e : m_.initialEquations) dae_.initialEquations.push_back({e.residual, e.origin, e.lhs, e.rhs});
+    dae_.initialEquations = m_.initialEquations;
   }
 };
 
 }  // namespace
 
-const char* roleName(VarRole r) {
+const char* roleName(UnknownRole r) {
   switch (r) {
-    case VarRole::Coordinate: return "coordinate";
-    case VarRole::Velocity: return "velocity";
-    case VarRole::State: return "state";
-    case VarRole::Algebraic: return "algebraic";
-    case VarRole::Multiplier: return "multiplier";
+    case UnknownRole::Coordinate: return "coordinate";
+    case UnknownRole::Velocity: return "velocity";
+    case UnknownRole::State: return "state";
+    case UnknownRole::Algebraic: return "algebraic";
+    case UnknownRole::Multiplier: return "multiplier";
   }
   return "?";
 }

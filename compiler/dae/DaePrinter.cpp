@@ -114,7 +114,7 @@ void printEquationsJson(std::ostream& os, const Dae& dae, const sym::Context& ct
     const Variable& v = dae.variables[i];
     os << (i ? ",\n" : "\n") << "    {\"name\": " << jsonString(v.name) << ", \"kind\": "
        << jsonString(v.kind == VarKind::State ? "state" : "algebraic") << ", \"role\": " << jsonString(roleName(v.role))
-       << (v.start ? ", \"start\": " + str(v.start) : std::string()) << "}";
+       << (v.declaration.start ? ", \"start\": " + str(v.declaration.start) : std::string()) << "}";
   }
   os << "\n  ],\n  \"parameters\": [";
   for (size_t i = 0; i < dae.parameters.size(); ++i)

@@ -66,9 +66,10 @@ class Builder {
   // Coordinates and velocities that are states start fixed; another state is fixed if it has a
   // start value (or fixed = true); an algebraic variable's start is only a guess unless fixed.
   static bool defaultFixed(const dae::Variable& v) {
-    if (v.fixed) return true;
+    if (v.declaration.fixed) return true;
     if (v.kind != dae::VarKind::State) return false;
-    return v.role == dae::VarRole::Coordinate || v.role == dae::VarRole::Velocity || v.start != nullptr;
+    return v.role == dae::UnknownRole::Coordinate || v.role == dae::UnknownRole::Velocity ||
+           v.declaration.start != nullptr;
   }
 
   // Name of the DAE variable that is flat variable `flatVar` (a map, built once: labels are made
@@ -223,8 +224,8 @@ class Builder {
     std::vector<Start> starts(dae_.variables.size());
     for (size_t j = 0; j < dae_.variables.size(); ++j) {
       const auto& v = dae_.variables[j];
-      starts[j].y0 = v.start;
-      if (v.start) starts[j].source = addSource("start value of " + v.name, v.declRange);
+      starts[j].y0 = v.declaration.start;
+      if (v.declaration.start) starts[j].source = addSource("start value of " + v.name, v.declaration.declRange);
     }
     for (size_t i = 0; i < dae_.initialEquations.size(); ++i)
       if (!applyInitialEquation(i, starts))
@@ -249,7 +250,8 @@ class Builder {
     for (uint32_t j = 0; j < n; ++j) store(n + j, starts[j].yp0, starts[j].derivativeSource);
     for (uint32_t j = 0; j < n; ++j) {
       const auto& v = dae_.variables[j];
-      store(2 * n + j, v.nominal, v.nominal ? addSource("nominal value of " + v.name, v.declRange) : UINT32_MAX);
+      sym::Expr nominal = v.declaration.nominal;
+      store(2 * n + j, nominal, nominal ? addSource("nominal value of " + v.name, v.declaration.declRange) : UINT32_MAX);
     }
     reportUnbound(b, "start values (only parameters may be used)");
     m_.program(ModelProgram::InitialValues) = b.finish(3 * n);

@@ -73,7 +73,7 @@ TEST_P(ExamplesTest, ParametersAndStartValuesMatchDirectEvaluation) {
   std::vector<double> v = m.symbolValues(0, y0, yp0, p);
   for (size_t j = 0; j < n; ++j) {
     const auto& var = m.dae->variables[j];
-    double expected = var.start ? sym::evaluate(var.start, v) : 0.0;
+    double expected = var.declaration.start ? sym::evaluate(var.declaration.start, v) : 0.0;
     bool setByInitialEquation = false;
     for (const auto& e : m.dae->initialEquations) setByInitialEquation |= e.lhs == var.y;
     if (!setByInitialEquation) {

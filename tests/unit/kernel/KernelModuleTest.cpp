@@ -121,7 +121,7 @@ TEST(Kernel, CyclicParameterBindingsAreReported) {
 
 TEST(Kernel, StartValuesNominalsAndFixedFlags) {
   TinyDae d;
-  d.dae.variables[0].nominal = d.ctx.constant(4);
+  d.dae.variables[0].declaration.nominal = d.ctx.constant(4);
   kernel::KernelModule m = kernel::buildKernels(d.dae, d.ctx);
   std::vector<double> p = {3.0, 1.5}, out(6);
   kernel::interpret(m.program(ModelProgram::InitialValues), {.p = p.data()}, out);
