@@ -5,6 +5,8 @@
 
 #include <cstdint>
 
+#include "qdot/programs.hpp"
+
 extern "C" {
 extern const uint8_t qdot_model_bytes[];
 extern const uint64_t qdot_model_size;
@@ -16,9 +18,9 @@ extern const uint8_t qdot_experiment_given[4];
 /// overridden, out, spill.
 typedef void (*qdot_program_fn)(const double* tcj, const double* y, const double* yp, const double* p,
                                 const double* given, const uint8_t* overridden, double* out, double* spill);
-/// Per kernel program (parameters, initialValues, residual, jacobian, outputs, invariants): the
+/// Per model program (qdot/programs.def order): the
 /// native code, or all null when the model runs on the VM.
-extern const qdot_program_fn qdot_native_programs[6];
+extern const qdot_program_fn qdot_native_programs[qdot::kModelProgramCount];
 /// Doubles of spill memory each native program needs.
-extern const uint32_t qdot_native_spill[6];
+extern const uint32_t qdot_native_spill[qdot::kModelProgramCount];
 }

@@ -35,8 +35,8 @@ struct NativeModel : AdaptedModel {
 
 }  // namespace
 
-Result<ModelPtr> createNativeModel(std::span<const uint8_t> bytes, const qdot_program_fn programs[6],
-                                   const uint32_t spill[6]) {
+Result<ModelPtr> createNativeModel(std::span<const uint8_t> bytes, const qdot_program_fn programs[kModelProgramCount],
+                                   const uint32_t spill[kModelProgramCount]) {
   Result<bc::Module> module = bc::deserialize(bytes);
   if (!module) return Error{module.error()};
   auto m = std::make_unique<NativeModel>();

@@ -14,7 +14,7 @@ namespace qdot::exe {
 
 /// A model of the serialised module `bytes` whose programs run as `programs` (with `spill` doubles
 /// of scratch each), or why the bytes are not a valid module.
-Result<ModelPtr> createNativeModel(std::span<const uint8_t> bytes, const qdot_program_fn programs[6],
-                                   const uint32_t spill[6]);
+Result<ModelPtr> createNativeModel(std::span<const uint8_t> bytes, const qdot_program_fn programs[kModelProgramCount],
+                                   const uint32_t spill[kModelProgramCount]);
 
 }  // namespace qdot::exe
