@@ -38,7 +38,7 @@ class FunctionChecker {
       auto op = static_cast<Opcode>(f_.code[pc]);
       uint32_t n = operandCount(info(op).format);
       if (pc + n >= f_.code.size()) return "truncated instruction" + at(pc);
-      std::string e = operands(op, &f_.code[pc + 1]);
+      std::string e = operands(&f_.code[pc]);
       if (!e.empty()) return e + at(pc);
       ended = op == Opcode::Ret;
       pc += 1 + n, ++instructions;
@@ -67,20 +67,17 @@ class FunctionChecker {
     }
   }
 
-  std::string operands(Opcode op, const uint32_t* o) const {
-    if (!loadAllowed(program_, op)) return std::string(info(op).mnemonic) + " is not available in this function";
-    bool ok = true;
-    switch (info(op).format) {
-      case Format::End: break;
-      case Format::None: ok = dst(o[0]); break;
-      case Format::Index: ok = dst(o[0]) && indexOk(op, o[1]); break;
-      case Format::Unary:
-      case Format::UnaryIndex: ok = dst(o[0]) && src(o[1]); break;
-      case Format::Binary: ok = dst(o[0]) && src(o[1]) && src(o[2]); break;
-      case Format::Ternary: ok = dst(o[0]) && src(o[1]) && src(o[2]) && src(o[3]); break;
-      case Format::Store: ok = o[0] < f_.outputCount && src(o[1]); break;
-    }
-    return ok ? "" : std::string("operand out of range in ") + info(op).mnemonic;
+  // The operands of the instruction at ip, by its format (the arity table of qdot/bytecode.h).
+  std::string operands(const uint32_t* ip) const {
+    Instruction ins = decode(ip);
+    Format f = info(ins.op).format;
+    if (!loadAllowed(program_, ins.op)) return std::string(info(ins.op).mnemonic) + " is not available in this function";
+    const uint32_t reads[3] = {ins.a, ins.b, ins.c};
+    bool ok = !definesRegister(f) || dst(ins.dest);
+    for (uint32_t i = 0; i < readCount(f); ++i) ok = ok && src(reads[i]);
+    if (f == Format::Index) ok = ok && indexOk(ins.op, ins.imm);
+    if (f == Format::Store) ok = ok && ins.imm < f_.outputCount;
+    return ok ? "" : std::string("operand out of range in ") + info(ins.op).mnemonic;
   }
 
   const Module& m_;
