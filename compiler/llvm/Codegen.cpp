@@ -12,6 +12,8 @@
 // No fast-math flags are set anywhere, so LLVM may not reassociate or contract.
 #include "llvm/Codegen.h"
 
+#include <array>
+#include <cstddef>
 #include <unordered_map>
 
 #include <llvm/IR/IRBuilder.h>
@@ -26,7 +28,19 @@ using kernel::Instr;
 using kernel::Op;
 
 /// The arguments of every generated function, in ProgramFn order.
-enum Arg : unsigned { kTimeCj, kY, kYp, kP, kGiven, kOverridden, kOut, kSpill, kArgCount };
+enum Arg : unsigned { kCall, kOut, kSpill, kArgCount };
+
+/// The fields of qdot::ModelCall, in declaration order (the LLVM struct below mirrors its layout).
+enum CallField : unsigned { kTime, kCj, kY, kYp, kP, kGiven, kOverridden };
+static_assert(offsetof(ModelCall, t) == 0 && offsetof(ModelCall, cj) == 8 && offsetof(ModelCall, y) == 16 &&
+                  offsetof(ModelCall, overridden) == 48 && sizeof(ModelCall) == 56,
+              "the generated code reads qdot::ModelCall as {double, double, ptr x 5}");
+
+llvm::StructType* callType(llvm::LLVMContext& c) {
+  auto* ptr = llvm::PointerType::getUnqual(c);
+  auto* dbl = llvm::Type::getDoubleTy(c);
+  return llvm::StructType::get(c, {dbl, dbl, ptr, ptr, ptr, ptr, ptr});
+}
 
 llvm::Function* declareProgramFunction(llvm::Module& m, const std::string& name, bool internal) {
   llvm::LLVMContext& c = m.getContext();
@@ -67,7 +81,20 @@ class PartLowering {
   llvm::Value* elementPtr(Arg a, uint32_t index, llvm::Type* type) {
     return b_.CreateConstInBoundsGEP1_64(type, fn_->getArg(a), index);
   }
-  llvm::Value* loadInput(Arg a, uint32_t index) { return b_.CreateLoad(dbl_, elementPtr(a, index, dbl_)); }
+  // Field `f` of the ModelCall: t and cj are values, the others the arrays' addresses (loaded once
+  // per part; a part is one basic block, so the first load dominates every use).
+  llvm::Value* callField(CallField f) {
+    llvm::Value*& v = fields_[f];
+    if (!v) {
+      llvm::Type* type = f <= kCj ? dbl_ : static_cast<llvm::Type*>(llvm::PointerType::getUnqual(mod_.getContext()));
+      v = b_.CreateLoad(type, b_.CreateStructGEP(callType(mod_.getContext()), fn_->getArg(kCall), f));
+    }
+    return v;
+  }
+  llvm::Value* inputPtr(CallField f, uint32_t index, llvm::Type* type) {
+    return b_.CreateConstInBoundsGEP1_64(type, callField(f), index);
+  }
+  llvm::Value* loadInput(CallField f, uint32_t index) { return b_.CreateLoad(dbl_, inputPtr(f, index, dbl_)); }
 
   // Register %v in this part: its value, a redone load, or a reload from the spill array.
   llvm::Value* value(uint32_t v) {
@@ -129,14 +156,14 @@ class PartLowering {
     auto B = [&] { return value(ins.b); };
     switch (ins.op) {
       case Op::Ret: return nullptr;
-      case Op::LoadTime: return loadInput(kTimeCj, 0);
-      case Op::LoadCj: return loadInput(kTimeCj, 1);
+      case Op::LoadTime: return callField(kTime);
+      case Op::LoadCj: return callField(kCj);
       case Op::LoadY: return loadInput(kY, ins.imm);
       case Op::LoadYp: return loadInput(kYp, ins.imm);
       case Op::LoadP: return loadInput(kP, ins.imm);
       case Op::LoadGiven: return loadInput(kGiven, ins.imm);
       case Op::LoadOverridden: {
-        llvm::Value* flag = b_.CreateLoad(b_.getInt8Ty(), elementPtr(kOverridden, ins.imm, b_.getInt8Ty()));
+        llvm::Value* flag = b_.CreateLoad(b_.getInt8Ty(), inputPtr(kOverridden, ins.imm, b_.getInt8Ty()));
         return boolean(b_.CreateICmpNE(flag, b_.getInt8(0)));
       }
       case Op::LoadConst: return constant(prog_.constants[ins.imm]);
@@ -186,6 +213,7 @@ class PartLowering {
   size_t begin_, end_;
   std::vector<llvm::Value*> local_;                       // values of [begin_, end_)
   std::unordered_map<uint32_t, llvm::Value*> imported_;  // earlier parts' values used here
+  std::array<llvm::Value*, kOverridden + 1> fields_{};    // ModelCall fields loaded in this part
 };
 
 void emitCaller(llvm::Function* entry, const std::vector<llvm::Function*>& parts) {

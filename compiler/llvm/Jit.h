@@ -13,12 +13,10 @@
 
 namespace qdot::llvmbackend {
 
-/// The C signature of every compiled program (see README.md):
-///   tcj = {t, cj}; y, yp [nVariables]; p, given, overridden [nParameters] (inputs a program does
-///   not read may be null); out [outputCount]; spill [spill slots of the program] (scratch).
-/// `out` and `spill` must not overlap the inputs.
-using ProgramFn = void (*)(const double* tcj, const double* y, const double* yp, const double* p, const double* given,
-                           const uint8_t* overridden, double* out, double* spill);
+/// The C signature of every compiled program (see README.md): `call` holds the inputs (those a
+/// program does not read may be null); out [outputCount]; spill [spill slots of the program]
+/// (scratch). `out` and `spill` must not overlap the inputs.
+using ProgramFn = void (*)(const ModelCall* call, double* out, double* spill);
 
 /// Compiled code of every program; owns the LLJIT instance (and so the machine code).
 class JitSession {

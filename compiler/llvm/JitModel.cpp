@@ -37,11 +37,10 @@ struct JitModel : AdaptedModel {
   /// non-finite result is traced on the kernel IR for lastError.
   int run(ModelProgram program, const ModelCall& c, double* out) const {
     const kernel::Program& code = kernels.program(program);
-    const double tcj[2] = {c.t, c.cj};
     double* scratch = spill[programIndex(program)].data();
     std::span<const ProgramFn> parts = session->program(program);
     if (parts.empty()) kernel::interpret(code, c, {out, code.outputCount});
-    for (ProgramFn part : parts) part(tcj, c.y, c.yp, c.p, c.given, c.overridden, out, scratch);
+    for (ProgramFn part : parts) part(&c, out, scratch);
     for (uint32_t i = 0; i < code.outputCount; ++i)
       if (!std::isfinite(out[i])) {
         error = diagnoseNonFinite(kernels.description, locations, program, traceOf(code), c);

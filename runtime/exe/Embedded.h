@@ -14,10 +14,8 @@ extern const uint64_t qdot_model_size;
 extern const double qdot_experiment_values[4];
 extern const uint8_t qdot_experiment_given[4];
 
-/// A compiled kernel program (compiler/llvm/Jit.h, ProgramFn): tcj = {t, cj}, y, yp, p, given,
-/// overridden, out, spill.
-typedef void (*qdot_program_fn)(const double* tcj, const double* y, const double* yp, const double* p,
-                                const double* given, const uint8_t* overridden, double* out, double* spill);
+/// A compiled kernel program (compiler/llvm/Jit.h, ProgramFn): the call's inputs, out, spill.
+typedef void (*qdot_program_fn)(const qdot::ModelCall* call, double* out, double* spill);
 /// Per model program (qdot/programs.def order): the
 /// native code, or all null when the model runs on the VM.
 extern const qdot_program_fn qdot_native_programs[qdot::kModelProgramCount];

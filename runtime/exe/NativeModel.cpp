@@ -23,8 +23,7 @@ struct NativeModel : AdaptedModel {
 
   int run(ModelProgram program, const ModelCall& c, double* out) const {
     size_t i = programIndex(program);
-    const double tcj[2] = {c.t, c.cj};
-    programs[i](tcj, c.y, c.yp, c.p, c.given, c.overridden, out, spill[i].data());
+    programs[i](&c, out, spill[i].data());
     size_t count = description.outputCount(program);
     if (std::all_of(out, out + count, [](double x) { return std::isfinite(x); })) return 0;
     std::vector<double> scratch(count);  // the VM fails the same way and says where
