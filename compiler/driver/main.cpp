@@ -16,10 +16,14 @@
 
 #include "ast/ASTPrinter.h"
 #include "bytecode/Emitter.h"
+#include "dae/PrintDae.h"
 #include "driver/Pipeline.h"
+#include "flatten/FlatPrinter.h"
 #include "kernel/Kernel.h"
 #include "llvm/JitModel.h"
 #include "llvm/ObjectFile.h"
+#include "llvm/PrintIR.h"
+#include "mechanics/EomPrinter.h"
 #include "sim/Run.h"
 #include "sim/TieredModel.h"
 #include "vm/Vm.h"
@@ -55,10 +59,37 @@ void printTimings(const driver::StageTimes& t) {
             << t.flatten * 1e3 << ", derive " << t.derive * 1e3 << ", dae " << t.dae * 1e3 << "\n";
 }
 
+// --emit=STAGE (every command): runs the pipeline up to STAGE, prints that stage's output to
+// stdout and stops. The stages in pipeline order:
+const std::vector<std::string> kEmitStages = {"ast", "flat", "eom", "dae", "kernel", "bytecode", "llvm"};
+const char* const kEmitHelp =
+    "print one stage's output and stop: ast, flat (flattened model), eom (equations of motion), dae, kernel, "
+    "bytecode, llvm (LLVM IR)";
+
+int emitStage(const Options& o) {
+  driver::Compilation c;
+  driver::Stage until = o.emit == "ast"    ? driver::Stage::Parse
+                        : o.emit == "flat" ? driver::Stage::Flatten
+                        : o.emit == "eom"  ? driver::Stage::Derive
+                                           : driver::Stage::Dae;
+  if (!driver::compileFile(c, o.file, o.model, until)) return finish(c, false);
+  if (o.emit == "ast") ast::printAST(std::cout, *c.ast, c.sources);
+  if (o.emit == "flat") flat::printFlatModel(std::cout, *c.flat, c.ctx, c.sources);
+  if (o.emit == "eom") mech::printEquationsOfMotion(std::cout, *c.eom, *c.flat, c.ctx, c.sources);
+  if (o.emit == "dae") dae::printDae(std::cout, *c.dae, c.ctx, c.sources);
+  if (until != driver::Stage::Dae || o.emit == "dae") return finish(c, true);
+  kernel::KernelModule kernels = kernel::buildKernels(*c.dae, c.ctx);
+  for (const auto& e : kernels.errors) c.diags.error(c.dae->range, "E0601", e);
+  if (!kernels.errors.empty()) return finish(c, false);
+  if (o.emit == "kernel") kernel::printKernels(std::cout, kernels, &c.sources);
+  if (o.emit == "bytecode") vm::disassemble(std::cout, bytecode::emitBytecode(kernels, c.sources));
+  if (o.emit == "llvm") llvmbackend::printIR(std::cout, kernels, llvmbackend::JitOptions{}.maxInstructionsPerFunction);
+  return finish(c, true);
+}
+
 int runCheck(const Options& o) {
   driver::Compilation c;
-  bool ok = driver::compileFile(c, o.file, o.model, o.emit == "ast" ? driver::Stage::Parse : driver::Stage::Dae);
-  if (ok && o.emit == "ast") ast::printAST(std::cout, *c.ast, c.sources);
+  bool ok = driver::compileFile(c, o.file, o.model, driver::Stage::Dae);
   if (o.timings) printTimings(c.times);
   return finish(c, ok);
 }
@@ -170,14 +201,6 @@ int runSimulate(const Options& o) {
   double kernelSeconds = secondsSince(t0);
   for (const auto& e : kernels.errors) c.diags.error(c.dae->range, "E0601", e);
   if (!kernels.errors.empty()) return finish(c, false);
-  if (o.emit == "kernel") {
-    kernel::printKernels(std::cout, kernels, &c.sources);
-    return finish(c, true);
-  }
-  if (o.emit == "bytecode") {
-    vm::disassemble(std::cout, bytecode::emitBytecode(kernels, c.sources));
-    return finish(c, true);
-  }
   t0 = std::chrono::steady_clock::now();
   CompiledModel compiled = compileModel(kernels, c.sources, o);
   double codegenSeconds = secondsSince(t0);
@@ -334,13 +357,14 @@ int main(int argc, char** argv) {
   auto* check = app.add_subcommand("check", "Parse and check a model; print diagnostics (exit 1 on errors)");
   check->add_option("file", o.file, "the model file (.qd)")->required()->check(CLI::ExistingFile);
   check->add_option("--model", o.model, "the model to check (default: the last model in the file)");
-  check->add_option("--emit", o.emit, "also print a stage's output: ast")->check(CLI::IsMember({"ast"}));
+  check->add_option("--emit", o.emit, kEmitHelp)->check(CLI::IsMember(kEmitStages));
   check->add_flag("--timings", o.timings, "print the time each stage took");
 
   auto* eqs = app.add_subcommand("equations", "Print the derived equations of motion and the DAE");
   eqs->add_option("file", o.file, "the model file (.qd)")->required()->check(CLI::ExistingFile);
   eqs->add_option("--model", o.model, "the model (default: the last model in the file)");
   eqs->add_flag("--json", o.json, "print JSON for tools instead of text");
+  eqs->add_option("--emit", o.emit, kEmitHelp)->check(CLI::IsMember(kEmitStages));
   eqs->add_flag("--timings", o.timings, "print the time each stage took");
 
   std::string first = argc > 1 ? argv[1] : "";
@@ -362,8 +386,7 @@ int main(int argc, char** argv) {
   run->add_flag("--jit-wait", o.jitWait,
                 "with --backend llvm: compile before the first step instead of starting on the VM while the JIT "
                 "compiles in the background (same results either way)");
-  run->add_option("--emit", o.emit, "print a stage's output instead of running: kernel, bytecode")
-      ->check(CLI::IsMember({"kernel", "bytecode"}));
+  run->add_option("--emit", o.emit, kEmitHelp)->check(CLI::IsMember(kEmitStages));
   rt::addRunOptions(*run, o.run);
 
 #ifdef QDOT_EXE_LIBS
@@ -371,10 +394,11 @@ int main(int argc, char** argv) {
       "build", "Compile a model into a standalone executable taking the run options of 'qdot run' (from the build tree)");
   build->add_option("file", o.file, "the model file (.qd)")->required()->check(CLI::ExistingFile);
   build->add_option("--model", o.model, "the model (default: the last model in the file)");
-  build->add_option("-o,--output", o.exePath, "the executable to write")->required();
+  build->add_option("-o,--output", o.exePath, "the executable to write (required unless --emit)");
   build->add_option("--backend", o.buildBackend,
                     "code generator: llvm (native code, default) or bytecode (the VM, linked in)")
       ->check(CLI::IsMember({"bytecode", "llvm"}));
+  build->add_option("--emit", o.emit, kEmitHelp)->check(CLI::IsMember(kEmitStages));
 #endif
 
   try {
@@ -389,7 +413,14 @@ int main(int argc, char** argv) {
     app.exit(e);
     return 2;
   }
+#ifdef QDOT_EXE_LIBS
+  if (*build && o.emit.empty() && o.exePath.empty()) {
+    std::cerr << "qdot build: -o,--output is required (the executable to write)\nRun with --help for more information.\n";
+    return 2;
+  }
+#endif
   try {
+    if (!o.emit.empty()) return emitStage(o);
     if (*check) return runCheck(o);
     if (*run) return runSimulate(o);
 #ifdef QDOT_EXE_LIBS
