@@ -72,7 +72,9 @@ int emitStage(const Options& o) {
                         : o.emit == "flat" ? driver::Stage::Flatten
                         : o.emit == "eom"  ? driver::Stage::Derive
                                            : driver::Stage::Dae;
-  if (!driver::compileFile(c, o.file, o.model, until)) return finish(c, false);
+  bool ok = driver::compileFile(c, o.file, o.model, until);
+  if (o.timings) printTimings(c.times);
+  if (!ok) return finish(c, false);
   if (o.emit == "ast") ast::printAST(std::cout, *c.ast, c.sources);
   if (o.emit == "flat") flat::printFlatModel(std::cout, *c.flat, c.ctx, c.sources);
   if (o.emit == "eom") mech::printEquationsOfMotion(std::cout, *c.eom, *c.flat, c.ctx, c.sources);
