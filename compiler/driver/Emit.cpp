@@ -2,6 +2,10 @@
 #include "driver/Emit.h"
 
 #include "ast/ASTPrinter.h"
+#include "dae/PrintDae.h"
+#include "flatten/FlatPrinter.h"
+#include "llvm/PrintIR.h"
+#include "mechanics/EomPrinter.h"
 #include "vm/Vm.h"
 
 namespace qdot::driver {
@@ -15,8 +19,12 @@ struct EmitEntry {
 
 constexpr EmitEntry kEmitStages[] = {
     {EmitStage::Ast, "ast", Stage::Parse},
+    {EmitStage::Flat, "flat", Stage::Flatten},
+    {EmitStage::Eom, "eom", Stage::Derive},
+    {EmitStage::Dae, "dae", Stage::Dae},
     {EmitStage::Kernel, "kernel", Stage::Kernel},
     {EmitStage::Bytecode, "bytecode", Stage::Bytecode},
+    {EmitStage::Llvm, "llvm", Stage::Kernel},  // printed from the kernels: no JIT needed
 };
 
 const EmitEntry& entry(EmitStage stage) {
@@ -50,8 +58,14 @@ Stage stageNeeded(EmitStage stage) { return entry(stage).needs; }
 bool emit(Compilation& c, EmitStage stage, std::ostream& os) {
   switch (stage) {
     case EmitStage::Ast: ast::printAST(os, *c.ast, c.sources); return true;
+    case EmitStage::Flat: flat::printFlatModel(os, *c.flat, c.ctx, c.sources); return true;
+    case EmitStage::Eom: mech::printEquationsOfMotion(os, *c.eom, *c.flat, c.ctx, c.sources); return true;
+    case EmitStage::Dae: dae::printDae(os, *c.dae, c.ctx, c.sources); return true;
     case EmitStage::Kernel: kernel::printKernels(os, *c.kernels, &c.sources); return true;
     case EmitStage::Bytecode: vm::disassemble(os, *c.bytecode); return true;
+    case EmitStage::Llvm:  // the module the JIT and qdot build compile, split as qdot run splits it
+      llvmbackend::printIR(os, *c.kernels, c.options.jit.maxInstructionsPerFunction);
+      return true;
   }
   return false;
 }

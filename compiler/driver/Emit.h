@@ -13,7 +13,7 @@
 namespace qdot::driver {
 
 /// What --emit can print, in pipeline order.
-enum class EmitStage { Ast, Kernel, Bytecode };
+enum class EmitStage { Ast, Flat, Eom, Dae, Kernel, Bytecode, Llvm };
 
 /// The stage spelled `name` ("ast", "kernel", ...), or nullopt.
 std::optional<EmitStage> parseEmitStage(std::string_view name);

@@ -50,6 +50,7 @@ void printTimings(const driver::StageTimes& t) {
 ExitCode emitStage(driver::Compilation& c, const Options& o) {
   driver::EmitStage stage = *driver::parseEmitStage(o.emit);
   bool ok = driver::compileFile(c, o.file, driver::stageNeeded(stage)) && driver::emit(c, stage, std::cout);
+  if (o.timings) printTimings(c.times);
   if (!ok && !c.internalError.empty()) {
     c.diags.render(std::cerr, c.sources, isatty(2));
     std::cerr << "qdot: internal error: " << c.internalError << "\n";
@@ -183,7 +184,7 @@ int main(int argc, char** argv) {
   rt::addRunOptions(*run, o.run);
 
   auto* build = addCommand(app, "build", "Compile a model into a standalone executable taking the run options of 'qdot run'", o);
-  build->add_option("-o,--output", o.exe.outputPath, "the executable to write")->required();
+  build->add_option("-o,--output", o.exe.outputPath, "the executable to write (required unless --emit)");
   build->add_option("--backend", o.buildBackend, "code generator: llvm (native code, default) or bytecode (the VM, linked in)")
       ->check(CLI::IsMember({"bytecode", "llvm"}));
 
@@ -205,6 +206,10 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : toInt(ExitCode::Usage);
   }
   Action action = *check ? Action::Check : *eqs ? Action::Equations : *run ? Action::Run : Action::Build;
+  if (action == Action::Build && o.emit.empty() && o.exe.outputPath.empty()) {
+    std::cerr << "qdot build: -o,--output is required (the executable to write)\nRun with --help for more information.\n";
+    return toInt(ExitCode::Usage);
+  }
   try {
     return toInt(dispatch(action, o));
   } catch (const std::exception& e) {  // a bug, not a user error: say so instead of aborting
