@@ -17,7 +17,6 @@
 #include <string>
 #include <vector>
 
-#include "bytecode/Emitter.h"
 #include "driver/Pipeline.h"
 #include "kernel/Kernel.h"
 #include "reference/NLinkPendulum.h"
@@ -41,12 +40,11 @@ ModelPtr compileWithSize(const std::string& file, int n) {
   std::string text = std::regex_replace(readFile(file), std::regex("parameter Integer n = [0-9]+"),
                                         "parameter Integer n = " + std::to_string(n));
   driver::Compilation c;
-  if (!driver::compileSource(c, file, text, "", driver::Stage::Dae)) {
+  if (!driver::compileSource(c, file, text, "", driver::Stage::Bytecode)) {
     c.diags.render(std::cerr, c.sources);
     throw std::runtime_error("qdot could not compile " + file);
   }
-  kernel::KernelModule kernels = kernel::buildKernels(*c.dae, c.ctx);
-  Result<ModelPtr> model = vm::createModel(bytecode::emitBytecode(kernels, c.sources));
+  Result<ModelPtr> model = vm::createModel(*c.bytecode);
   if (!model) throw std::runtime_error(model.error());
   return std::move(model).value();
 }

@@ -18,7 +18,6 @@
 #include <limits>
 #include <vector>
 
-#include "bytecode/Emitter.h"
 #include "driver/Pipeline.h"
 #include "kernel/Kernel.h"
 #include "llvm/JitModel.h"
@@ -124,25 +123,21 @@ int main(int argc, char** argv) {
   for (int r = 0; r < repeat; ++r) {
     vmModel.reset(), jitModel.reset();
     driver::Compilation c;
-    if (!driver::compileFile(c, file, "", driver::Stage::Dae)) {
+    c.options.jit = llvmbackend::JitOptions{};  // the defaults, as qdot run --jit-wait
+    if (!driver::compileFile(c, file, "", driver::Stage::Kernel)) {
       c.diags.render(std::cerr, c.sources);
       return 1;
     }
     const auto& t = c.times;
     parse = std::min(parse, t.parse), check = std::min(check, t.check), flatten = std::min(flatten, t.flatten);
-    derive = std::min(derive, t.derive), dae = std::min(dae, t.dae);
-    auto t0 = Clock::now();
-    kernel::KernelModule kernels = kernel::buildKernels(*c.dae, c.ctx);
-    kernel = std::min(kernel, secondsSince(t0));
-    if (!kernels.errors.empty()) {
-      std::cerr << kernels.errors.front() << "\n";
-      return 1;
-    }
+    derive = std::min(derive, t.derive), dae = std::min(dae, t.dae), kernel = std::min(kernel, t.kernel);
+    const kernel::KernelModule& kernels = *c.kernels;
     instructions = 0;
     for (const auto& p : kernels.programs) instructions += p.code.size();
     residualInstructions = kernels.program(ModelProgram::Residual).code.size();
-    t0 = Clock::now();
-    Result<ModelPtr> vm = vm::createModel(bytecode::emitBytecode(kernels, c.sources));
+    auto t0 = Clock::now();
+    driver::continueTo(c, driver::Stage::Bytecode);
+    Result<ModelPtr> vm = vm::createModel(*c.bytecode);
     bytecode = std::min(bytecode, secondsSince(t0));
     if (!vm) {
       std::cerr << vm.error() << "\n";
@@ -150,16 +145,13 @@ int main(int argc, char** argv) {
     }
     vmModel = std::move(vm).value();
     if (!noLlvm) {
-      llvmbackend::JitStats stats;
-      llvmbackend::JitOptions options;  // the defaults, as qdot run
-      t0 = Clock::now();
-      Result<ModelPtr> jit = llvmbackend::createJitModel(kernels, c.sources, options, &stats);
-      llvm = std::min(llvm, secondsSince(t0));
-      if (!jit) {
-        std::cerr << jit.error() << "\n";
+      if (!driver::continueTo(c, driver::Stage::Native)) {
+        std::cerr << c.internalError << "\n";
         return 1;
       }
-      jitModel = std::move(jit).value();
+      llvm = std::min(llvm, t.native);
+      jitModel = std::move(c.native);
+      const llvmbackend::JitStats& stats = c.jitStats;
       lower = std::min(lower, stats.lowerSeconds + stats.optimiseSeconds), codegen = std::min(codegen, stats.codegenSeconds);
       functions = 0;
       for (uint32_t f : stats.functions) functions += f;

@@ -1,7 +1,8 @@
 // vm_solve: `qdot run --backend bytecode|llvm` in one process, for timing the solve. It makes the calls
 // qdot's command line makes (compiler/driver/main.cpp runSimulate, runtime/sim/Run.cpp runModel):
-// compile to the DAE, kernels, bytecode and VM model (--backend bytecode, the default) or the LLVM
-// JIT model (--backend llvm: llvmbackend::createJitModel with the options qdot run uses), then rt::resolveRunOptions, rt::CsvWriter and
+// compile through the driver (driver::compileFile, driver::makeRunnableModel: the VM model with
+// --backend bytecode, the default, or the JIT model compiled first with --backend llvm, as
+// qdot run --jit-wait), then rt::resolveRunOptions, rt::CsvWriter and
 // rt::simulate — but repeats the simulation and reports the solve's wall time at full precision
 // (`qdot run --stats` rounds it to milliseconds) together with IDA's counters. --breakdown adds
 // one more run with the model's residual and Jacobian timed (their function pointers wrapped).
@@ -13,16 +14,10 @@
 #include <iostream>
 #include <memory>
 
-#include "bytecode/Emitter.h"
-#include "driver/Pipeline.h"
-#include "kernel/Kernel.h"
-#ifdef QDOT_BENCH_LLVM
-#include "llvm/JitModel.h"
-#endif
+#include "driver/Backends.h"
 #include "output/CsvWriter.h"
 #include "sim/RunOptions.h"
 #include "sim/StatsReport.h"
-#include "vm/Vm.h"
 
 namespace {
 
@@ -33,39 +28,31 @@ double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>
 
 /// The VM model of a file and the compile time in seconds (front end, kernels, bytecode).
 struct Compiled {
-  ModelPtr model;
+  std::unique_ptr<QdotModel, void (*)(QdotModel*)> model{nullptr, nullptr};
   rt::ExperimentDefaults experiment;
   double compileSeconds = 0;
   double kernelSeconds = 0, codegenSeconds = 0;  ///< the last two stages of compileSeconds
-  driver::StageTimes times;                          ///< parse .. dae
+  driver::StageTimes times;                      ///< parse .. kernel
 };
 
 Compiled compile(const std::string& file, const std::string& backend, bool invariants) {
   driver::Compilation c;
-  if (!driver::compileFile(c, file, "", driver::Stage::Dae)) {
+  if (!driver::compileFile(c, file, "", driver::Stage::Kernel)) {
     c.diags.render(std::cerr, c.sources);
     throw std::runtime_error("the model has errors");
   }
+  // As qdot run --backend llvm --jit-wait or --backend bytecode: compile time before the first step.
+  driver::Backend chosen = backend == "llvm" ? driver::Backend::Native : driver::Backend::Bytecode;
+  driver::RunnableModel runnable = driver::makeRunnableModel(c, chosen, invariants);
+  if (!runnable.model) throw std::runtime_error(runnable.error);
+  if (!runnable.warning.empty()) throw std::runtime_error(runnable.warning);
   Compiled out;
-  auto t0 = Clock::now();
-  kernel::KernelModule kernels = kernel::buildKernels(*c.dae, c.ctx);
-  if (!kernels.errors.empty()) throw std::runtime_error(kernels.errors.front());
-  out.kernelSeconds = secondsSince(t0);
-  t0 = Clock::now();
-  Result<ModelPtr> model = Error{"built without the LLVM backend"};
-  if (backend == "llvm") {
-#ifdef QDOT_BENCH_LLVM
-    model = llvmbackend::createJitModel(kernels, c.sources, llvmbackend::jitOptionsForRun(invariants));
-#endif
-  } else {
-    model = vm::createModel(bytecode::emitBytecode(kernels, c.sources));
-  }
-  if (!model) throw std::runtime_error(model.error());
-  out.codegenSeconds = secondsSince(t0);
-  out.model = std::move(model).value();
-  const auto& t = c.times;
-  out.times = t;
-  out.compileSeconds = t.parse + t.check + t.flatten + t.derive + t.dae + out.kernelSeconds + out.codegenSeconds;
+  out.kernelSeconds = c.times.kernel;
+  out.codegenSeconds = runnable.codegenSeconds;
+  QdotModel* model = runnable.model.release();
+  out.model = {model, model->destroy};
+  out.times = c.times;
+  out.compileSeconds = c.times.frontEnd() + out.codegenSeconds;
   const auto& e = c.dae->experiment;
   out.experiment = {e.startTime, e.stopTime, e.interval, e.tolerance};
   return out;

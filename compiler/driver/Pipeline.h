@@ -1,5 +1,11 @@
-// Pipeline: runs the compiler stages in order on one file and keeps every stage's result, so the
-// command line, the tests and the benchmarks all drive the compiler the same way.
+// Pipeline: runs the compiler stages in order on one model, from source text to a runnable model,
+// and keeps every stage's result, so the command line, the tests and the benchmarks all drive the
+// compiler the same way:
+//
+//   text ─ Parse ─ Check ─ Flatten ─ Derive ─ Dae ─ Kernel ─┬─ Bytecode   (the VM's module)
+//                                                           └─ Native     (the LLVM JIT's model)
+//
+// A later call may continue a compilation to a later stage (continueTo); each stage runs once.
 #pragma once
 
 #include <memory>
@@ -10,22 +16,40 @@
 #include "ast/AST.h"
 #include "dae/Dae.h"
 #include "flatten/Flatten.h"
+#include "kernel/Kernel.h"
+#include "llvm/JitModel.h"
 #include "mechanics/EulerLagrange.h"
+#include "qdot/bytecode.h"
+#include "qdot/result.hpp"
 #include "sema/Sema.h"
 #include "support/Diagnostic.h"
 #include "symbolic/Expr.h"
 
 namespace qdot::driver {
 
-enum class Stage { Parse, Check, Flatten, Derive, Dae };
+/// The stages, in order. Bytecode and Native are alternative backends of the kernels: asking for
+/// Native does not build the bytecode.
+enum class Stage { Parse, Check, Flatten, Derive, Dae, Kernel, Bytecode, Native };
 
-/// Wall time of each stage in seconds.
+/// Wall time of each stage in seconds (0 for a stage that did not run).
 struct StageTimes {
-  double parse = 0, check = 0, flatten = 0, derive = 0, dae = 0;
+  double parse = 0, check = 0, flatten = 0, derive = 0, dae = 0, kernel = 0, bytecode = 0, native = 0;
+  /// Everything from the text to the kernels (what both backends share).
+  double frontEnd() const { return parse + check + flatten + derive + dae + kernel; }
 };
 
-/// Everything one compilation creates; later stages point into earlier ones, so it is not copyable.
+/// How to compile; set before the first compile call.
+struct CompileOptions {
+  std::string model;            ///< the model to compile; empty: the file's last model
+  flat::FlattenLimits limits;   ///< size limits of flattening (tests and fuzzing lower them)
+  llvmbackend::JitOptions jit;  ///< what Stage::Native compiles, and how
+};
+
+/// Everything one compilation creates; later stages point into earlier ones, so it is not
+/// copyable. The kernels are shared: a background JIT (driver/Backends.h) keeps them alive for as
+/// long as it compiles, whatever happens to the Compilation.
 struct Compilation {
+  CompileOptions options;
   SourceManager sources;
   DiagnosticEngine diags;
   sym::Context ctx;
@@ -34,18 +58,33 @@ struct Compilation {
   std::optional<flat::FlatModel> flat;
   std::optional<mech::EquationsOfMotion> eom;
   std::optional<dae::Dae> dae;
+  std::shared_ptr<const kernel::KernelModule> kernels;
+  std::optional<bc::Module> bytecode;
+  ModelPtr native;                ///< the JIT-compiled model (Stage::Native)
+  llvmbackend::JitStats jitStats;  ///< how it was compiled
   StageTimes times;
-  flat::FlattenLimits limits;  ///< size limits of flattening (tests and fuzzing lower them)
+  Stage reached = Stage::Parse;  ///< the last stage that ran without errors (valid once `ok`)
+  bool ok = false;               ///< every stage run so far succeeded
+  std::string internalError;     ///< why a backend failed on valid kernels (a bug, not a model error)
 
   Compilation() = default;
   Compilation(const Compilation&) = delete;
   Compilation& operator=(const Compilation&) = delete;
 };
 
-/// Reads `path` and runs the stages up to `until` on the model `model` (empty: the file's last
-/// model). Returns false if any stage reported an error (see c.diags).
-bool compileFile(Compilation& c, const std::string& path, std::string_view model, Stage until);
+/// The file name that means standard input.
+inline constexpr std::string_view kStandardInput = "-";
+
+/// Reads `path` ("-": standard input) and runs the stages up to `until` on the model
+/// c.options.model. Returns false if any stage reported an error (see c.diags).
+bool compileFile(Compilation& c, const std::string& path, Stage until);
 /// The same for text in memory (tests, fuzzing); `name` is used in diagnostics.
+bool compileSource(Compilation& c, std::string name, std::string text, Stage until);
+/// Continues a successful compilation up to `until` (no-op for stages already run).
+bool continueTo(Compilation& c, Stage until);
+
+/// Shorthands with the model name (the last model of the file when empty).
+bool compileFile(Compilation& c, const std::string& path, std::string_view model, Stage until);
 bool compileSource(Compilation& c, std::string name, std::string text, std::string_view model, Stage until);
 
 }  // namespace qdot::driver

@@ -60,7 +60,7 @@ int main(int argc, char** argv) {
                                  : vm::createModelFromBytes(bytes);
   if (!created) {
     std::cerr << "error: the embedded model is invalid: " << created.error() << "\n";
-    return 4;
+    return toInt(ExitCode::Internal);
   }
   QdotModel* model = created->get();
   CLI::App app{fmt::format("{}: a qdot model; simulates it with SUNDIALS IDA and writes the results as CSV",
@@ -71,15 +71,15 @@ int main(int argc, char** argv) {
   int code = 0;
   try {
     app.parse(argc, argv);
-    code = rt::runModel(*model, options, embeddedExperiment(), std::cout, std::cerr);
+    code = toInt(rt::runModel(*model, options, embeddedExperiment(), std::cout, std::cerr));
   } catch (const CLI::CallForHelp& e) {
     code = app.exit(e);
   } catch (const CLI::ParseError& e) {
     app.exit(e);
-    code = rt::kUsageExitCode;
+    code = toInt(ExitCode::Usage);
   } catch (const std::exception& e) {
     std::cerr << "error: internal error: " << e.what() << "\n";
-    code = 4;
+    code = toInt(ExitCode::Internal);
   }
   return code;
 }

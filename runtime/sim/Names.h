@@ -17,9 +17,6 @@ class UsageError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// Exit code for a UsageError (same as the rest of qdot: 2 = bad command line).
-inline constexpr int kUsageExitCode = 2;
-
 /// Edit distance counting insertions, deletions, substitutions and swaps of neighbours
 /// (optimal string alignment), so "omgea" is 1 away from "omega".
 std::size_t editDistance(std::string_view a, std::string_view b);

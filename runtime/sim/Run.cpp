@@ -24,28 +24,28 @@ void report(const SimulationResult& result, bool stats, std::ostream& log) {
 
 }  // namespace
 
-int runModel(const QdotModel& model, const RunOptions& options, const ExperimentDefaults& experiment,
+ExitCode runModel(const QdotModel& model, const RunOptions& options, const ExperimentDefaults& experiment,
              std::ostream& csvOut, std::ostream& log) {
   ResolvedRun run;
   try {
     run = resolveRunOptions(options, experiment, model);
   } catch (const UsageError& e) {
     log << "error: " << e.what() << '\n';
-    return kUsageExitCode;
+    return ExitCode::Usage;
   } catch (const std::exception& e) {
     log << "error: " << e.what() << '\n';
-    return kFailureExitCode;
+    return ExitCode::SimulationFailed;
   }
   std::unique_ptr<CsvWriter> writer;
   try {
     writer = run.outputPath.empty() ? std::make_unique<CsvWriter>(csvOut) : CsvWriter::openFile(run.outputPath);
   } catch (const std::exception& e) {
     log << "error: " << e.what() << '\n';
-    return kFailureExitCode;
+    return ExitCode::SimulationFailed;
   }
   SimulationResult result = simulate(model, run.settings, *writer);
   report(result, run.stats, log);
-  return result.success ? 0 : kFailureExitCode;
+  return result.success ? ExitCode::Success : ExitCode::SimulationFailed;
 }
 
 }  // namespace qdot::rt

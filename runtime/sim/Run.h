@@ -5,18 +5,16 @@
 
 #include <ostream>
 
+#include "qdot/exit_code.hpp"
 #include "qdot/model_abi.h"
 #include "sim/RunOptions.h"
 
 namespace qdot::rt {
 
-/// Exit code when the model or the solver failed (usage errors give kUsageExitCode).
-inline constexpr int kFailureExitCode = 3;
-
 /// Runs model with the parsed options. CSV goes to options.outputPath, or to csvOut when it is
-/// empty; errors ("error: ..."), warnings and --stats go to log. Returns 0 on success,
-/// kFailureExitCode when the run failed (rows so far are written), kUsageExitCode for a bad option.
-int runModel(const QdotModel& model, const RunOptions& options, const ExperimentDefaults& experiment,
+/// empty; errors ("error: ..."), warnings and --stats go to log. Returns Success, SimulationFailed
+/// when the run failed (rows so far are written), Usage for a bad option.
+ExitCode runModel(const QdotModel& model, const RunOptions& options, const ExperimentDefaults& experiment,
              std::ostream& csvOut, std::ostream& log);
 
 }  // namespace qdot::rt

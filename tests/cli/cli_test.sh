@@ -30,6 +30,11 @@ check model-ok 0 "$qdot" check "$src/examples/textbook/utube.qd"
 check model-error 1 "$qdot" check "$src/tests/diagnostics/unknown_name.qd"
 check unknown-model 1 "$qdot" equations "$src/examples/textbook/utube.qd" --model Nope
 check emit-ast 0 "$qdot" check "$src/examples/textbook/utube.qd" --emit=ast
+check emit-unknown-stage 2 "$qdot" run "$src/examples/textbook/utube.qd" --emit=assembly
+if "$qdot" --help | grep -q '^  build'; then  # --emit needs no executable; without it, -o is required
+  check build-emit 0 "$qdot" build "$src/examples/textbook/utube.qd" --emit=llvm
+  check build-needs-output 2 "$qdot" build "$src/examples/textbook/utube.qd"
+fi
 # The README's first command: the U-tube's equation of motion, rho*A*(l ẍ + 2 g x) = 0 (checked
 # numerically against the textbook in TextbookExamplesTest; here: that it is what gets printed).
 contains utube-equation "x:  rho*A*l*der(der(x)) + 2*rho*A*g*x = 0" "$qdot" equations "$src/examples/textbook/utube.qd"

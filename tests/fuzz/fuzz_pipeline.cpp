@@ -9,9 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "bytecode/Emitter.h"
 #include "driver/Pipeline.h"
-#include "kernel/Kernel.h"
 #include "qdot/bytecode.h"
 
 namespace {
@@ -35,7 +33,7 @@ void checkDiagnostics(const driver::Compilation& c, size_t size) {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   driver::Compilation c;
-  c.limits.maxScalars = 20'000;  // keep each input fast; the limit itself is E0310
+  c.options.limits.maxScalars = 20'000;  // keep each input fast; the limit itself is E0310
   bool ok = driver::compileSource(c, "fuzz.qd", std::string(reinterpret_cast<const char*>(data), size), "",
                                   driver::Stage::Dae);
   checkDiagnostics(c, size);
@@ -47,9 +45,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::vector<sym::Expr> residuals;
   for (const auto& e : c.dae->equations) residuals.push_back(e.residual);
   if (c.ctx.dagSize(residuals) > 5'000) return 0;
-  kernel::KernelModule k = kernel::buildKernels(*c.dae, c.ctx);
-  bc::Module m = bytecode::emitBytecode(k, c.sources);
+  if (!driver::continueTo(c, driver::Stage::Bytecode)) return 0;  // E0601: reported, located
+  checkDiagnostics(c, size);
   std::string error;
-  check(bc::validate(m, error));
+  check(bc::validate(*c.bytecode, error));
   return 0;
 }

@@ -1,23 +1,18 @@
-// Test helper: runs the stages by hand from .qd text to a VM model (parse → check → flatten →
-// derive → DAE → kernel → bytecode → VM), keeping every intermediate result, and evaluates the
-// DAE's own expressions with sym::evaluate as the reference the VM is compared with.
+// Test helper: compiles .qd text through the pipeline to the bytecode and a VM model, keeping every
+// intermediate result, and evaluates the DAE's own expressions with sym::evaluate as the reference
+// the VM is compared with.
 #pragma once
 
 #include <gtest/gtest.h>
 
 #include <bit>
 #include <cmath>
-#include <fstream>
 #include <limits>
-#include <memory>
-#include <optional>
-#include <sstream>
-#include <unordered_map>
 #include <string>
+#include <unordered_map>
 
 #include "bytecode/Emitter.h"
 #include "unit/common/SourceDae.h"
-#include "kernel/Kernel.h"
 #include "vm/Vm.h"
 
 namespace qdot::test {
@@ -25,11 +20,8 @@ namespace qdot::test {
 class SourceModel : public SourceDae {
  public:
   /// Compiles `text` (named `name` in locations) down to a VM model; fails the test on errors.
-  SourceModel(const std::string& name, const std::string& text)
-      : SourceDae(name, text) {
+  SourceModel(const std::string& name, const std::string& text) : SourceDae(name, text, driver::Stage::Bytecode) {
     if (!dae) return;
-    kernel = kernel::buildKernels(*dae, ctx);
-    module = bytecode::emitBytecode(kernel, sources);
     Result<ModelPtr> created = vm::createModel(module);
     EXPECT_TRUE(created.ok()) << created.error();
     if (created) owned = std::move(created).value(), model = owned.get();
@@ -50,10 +42,14 @@ class SourceModel : public SourceDae {
     return v;
   }
 
-  kernel::KernelModule kernel;
-  bc::Module module;
+  const kernel::KernelModule& kernel = compilation.kernels ? *compilation.kernels : kNoKernels;
+  const bc::Module& module = compilation.bytecode ? *compilation.bytecode : kNoBytecode;
   ModelPtr owned;
   QdotModel* model = nullptr;  ///< owned.get()
+
+ private:
+  static inline const kernel::KernelModule kNoKernels{};
+  static inline const bc::Module kNoBytecode{};
 };
 
 /// Distance in units in the last place (0 for equal values, huge for NaN against a number).

@@ -1,21 +1,17 @@
-// Test helper shared by stage tests that start from .qd text but link only their own stage library
-// (not qdot_pipeline): runs parse → check → flatten → derive → DAE by hand and keeps every result.
-// Header-only: tests/unit/common has no .cpp, so it is not a test binary of its own.
+// Test helper shared by the stage tests that start from .qd text: compiles it through the
+// driver's pipeline (driver/Pipeline.h) up to a given stage and keeps every result; the members
+// name the stages' results the way the tests use them. Header-only: tests/unit/common has no
+// .cpp, so it is not a test binary of its own.
 #pragma once
 
 #include <gtest/gtest.h>
 
 #include <fstream>
-#include <memory>
 #include <optional>
 #include <sstream>
 #include <string>
 
-#include "dae/Dae.h"
-#include "flatten/Flatten.h"
-#include "mechanics/EulerLagrange.h"
-#include "sema/Sema.h"
-#include "syntax/Parser.h"
+#include "driver/Pipeline.h"
 
 namespace qdot::test {
 
@@ -26,32 +22,26 @@ inline std::string readFile(const std::string& path) {
   return ss.str();
 }
 
-/// The front end's results for one source text; `dae` is empty (and the test failed) on errors.
+/// The pipeline's results for one source text up to `until`; `dae` is empty (and the test failed)
+/// on errors.
 struct SourceDae {
-  SourceDae(const std::string& name, const std::string& text) {
-    uint32_t file = sources.addBuffer(name, text);
-    ast = syntax::parse(sources, file, diags);
-    if (!diags.hasErrors()) checked = sema::checkModel(*ast, "", diags);
-    if (checked && !diags.hasErrors()) flat = flat::flatten(*checked, ctx, diags);
-    if (flat) eom = mech::deriveEquationsOfMotion(*flat, ctx, diags);
-    if (eom) dae = dae::buildDae(*flat, *eom, ctx, diags);
-    if (!dae || diags.hasErrors()) {
+  SourceDae(const std::string& name, const std::string& text, driver::Stage until = driver::Stage::Dae,
+            const llvmbackend::JitOptions& jit = {}) {
+    compilation.options.jit = jit;
+    if (!driver::compileSource(compilation, name, text, "", until)) {
       std::ostringstream rendered;
       diags.render(rendered, sources);
-      ADD_FAILURE() << name << ":\n" << rendered.str();
+      ADD_FAILURE() << name << ":\n" << rendered.str() << compilation.internalError;
       dae.reset();
     }
   }
   SourceDae(const SourceDae&) = delete;
 
-  SourceManager sources;
-  DiagnosticEngine diags;
-  sym::Context ctx;
-  std::unique_ptr<ast::StoredDefinition> ast;
-  std::optional<sema::CheckedModel> checked;
-  std::optional<flat::FlatModel> flat;
-  std::optional<mech::EquationsOfMotion> eom;
-  std::optional<dae::Dae> dae;
+  driver::Compilation compilation;
+  SourceManager& sources = compilation.sources;
+  DiagnosticEngine& diags = compilation.diags;
+  sym::Context& ctx = compilation.ctx;
+  std::optional<dae::Dae>& dae = compilation.dae;
 };
 
 }  // namespace qdot::test

@@ -1,42 +1,37 @@
-// Test helper: runs the front end by hand from .qd text to a kernel::KernelModule (parse → check →
-// flatten → derive → DAE → kernel), then compiles it with the LLVM JIT. The kernel reference
-// interpreter (kernel::interpret) is what the compiled code is compared with.
+// Test helper: compiles .qd text through the pipeline to kernels and a JIT model (Stage::Native,
+// with the IR verifier on). The kernel reference interpreter (kernel::interpret) is what the
+// compiled code is compared with.
 #pragma once
 
 #include <gtest/gtest.h>
 
 #include <bit>
 #include <cmath>
-#include <fstream>
-#include <optional>
-#include <sstream>
 #include <string>
 
 #include "unit/common/SourceDae.h"
-#include "kernel/Kernel.h"
-#include "llvm/JitModel.h"
 
 namespace qdot::test {
+
+inline llvmbackend::JitOptions verified(llvmbackend::JitOptions options) {
+  options.verifyIR = true;
+  return options;
+}
 
 class KernelSource : public SourceDae {
  public:
   /// Compiles `text` (named `name` in locations) to kernels and a JIT model; fails the test on errors.
   KernelSource(const std::string& name, const std::string& text, llvmbackend::JitOptions options = {})
-      : SourceDae(name, text) {
-    if (!dae) return;
-    kernel = kernel::buildKernels(*dae, ctx);
-    options.verifyIR = true;
-    Result<ModelPtr> created = llvmbackend::createJitModel(kernel, sources, options, &stats);
-    EXPECT_TRUE(created.ok()) << created.error();
-    if (created) owned = std::move(created).value(), model = owned.get();
-  }
+      : SourceDae(name, text, driver::Stage::Native, verified(options)) {}
   KernelSource(const KernelSource&) = delete;
   bool ok() const { return model != nullptr; }
 
-  kernel::KernelModule kernel;
-  llvmbackend::JitStats stats;
-  ModelPtr owned;
-  QdotModel* model = nullptr;  ///< owned.get()
+  const kernel::KernelModule& kernel = compilation.kernels ? *compilation.kernels : kNoKernels;
+  const llvmbackend::JitStats& stats = compilation.jitStats;
+  QdotModel* model = compilation.native.get();
+
+ private:
+  static inline const kernel::KernelModule kNoKernels{};
 };
 
 /// Distance in units in the last place (0 for equal values or two NaNs, huge for NaN against a number).

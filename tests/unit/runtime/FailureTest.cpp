@@ -185,14 +185,14 @@ TEST(RunModel, ExitCodesForSuccessFailureAndUsage) {
   options.interval = 0.5;
   options.stats = true;
   std::ostringstream csv, log;
-  EXPECT_EQ(runModel(ok.abi(), options, {}, csv, log), 0) << log.str();
+  EXPECT_EQ(runModel(ok.abi(), options, {}, csv, log), ExitCode::Success) << log.str();
   EXPECT_EQ(csv.str().substr(0, csv.str().find('\n')), "time,x,v,a");
   EXPECT_NE(log.str().find("residual evaluations"), std::string::npos) << log.str();
   EXPECT_NE(log.str().find("linear solver          dense (chosen automatically)"), std::string::npos) << log.str();
 
   options.rtol = -1;
   std::ostringstream csv2, log2;
-  EXPECT_EQ(runModel(ok.abi(), options, {}, csv2, log2), kUsageExitCode);
+  EXPECT_EQ(runModel(ok.abi(), options, {}, csv2, log2), ExitCode::Usage);
   EXPECT_NE(log2.str().find("--rtol must be positive"), std::string::npos) << log2.str();
   EXPECT_TRUE(csv2.str().empty());
 
@@ -205,7 +205,7 @@ TEST(RunModel, ExitCodesForSuccessFailureAndUsage) {
   RunOptions o2;
   o2.interval = 0.25;
   std::ostringstream csv3, log3;
-  EXPECT_EQ(runModel(failing.abi(), o2, {}, csv3, log3), kFailureExitCode);
+  EXPECT_EQ(runModel(failing.abi(), o2, {}, csv3, log3), ExitCode::SimulationFailed);
   EXPECT_NE(log3.str().find("error: the simulation failed at t = 0.5"), std::string::npos) << log3.str();
   EXPECT_NE(log3.str().find("note: the 2 rows up to t = 0.25 were written"), std::string::npos) << log3.str();
 }

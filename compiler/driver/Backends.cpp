@@ -1,0 +1,106 @@
+// The tiering policy of qdot run (see Backends.h).
+#include "driver/Backends.h"
+
+#include <algorithm>
+#include <chrono>
+#include <ostream>
+#include <thread>
+
+#include "vm/Vm.h"
+
+namespace qdot::driver {
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The JIT before the first step; false (with out.error) if it failed.
+bool compileNativeFirst(Compilation& c, bool invariants, RunnableModel& out) {
+  c.options.jit = llvmbackend::jitOptionsForRun(invariants);
+  out.what = "llvm";
+  out.waited = true;
+  if (continueTo(c, Stage::Native)) {
+    out.model = std::move(c.native);
+    out.jit->stats = c.jitStats;
+    out.codegenSeconds = c.times.native;
+    return true;
+  }
+  out.jit->error = c.internalError;
+  return false;
+}
+
+// The VM model; false (with out.error) if the bytecode does not load, which is a bug.
+bool loadBytecode(Compilation& c, RunnableModel& out) {
+  if (!continueTo(c, Stage::Bytecode)) return false;
+  Result<ModelPtr> model = vm::createModel(*c.bytecode);
+  if (model) out.model = std::move(model).value();
+  else out.error = model.error();
+  out.what = "bytecode";
+  out.waited = false;
+  out.codegenSeconds = c.times.bytecode;
+  return out.model != nullptr;
+}
+
+// Wraps out.model (the VM) in a tiered model whose second tier the JIT compiles in the background,
+// leaving one core to the solver. The compile thread holds the kernels and its own copy of the
+// sources, so nothing it reads can go away while it runs.
+void addBackgroundJit(const Compilation& c, bool invariants, RunnableModel& out) {
+  llvmbackend::JitOptions options = llvmbackend::jitOptionsForRun(invariants);
+  options.threads = std::max(2u, std::thread::hardware_concurrency()) - 1;
+  auto sources = std::make_shared<const SourceManager>(c.sources);
+  out.what = "bytecode then llvm";
+  out.model = rt::createTieredModel(
+      std::move(out.model), [kernels = c.kernels, sources, options, jit = out.jit](const std::atomic<bool>& cancel) {
+        llvmbackend::JitOptions withCancel = options;
+        withCancel.cancel = &cancel;
+        Result<ModelPtr> model = llvmbackend::createJitModel(*kernels, *sources, withCancel, &jit->stats);
+        if (!model) jit->error = model.error();
+        return model ? std::move(model).value() : ModelPtr();
+      });
+}
+
+}  // namespace
+
+RunnableModel makeRunnableModel(Compilation& c, Backend backend, bool invariants) {
+  RunnableModel out;
+  auto t0 = std::chrono::steady_clock::now();
+  if (backend == Backend::Native) {
+    if (compileNativeFirst(c, invariants, out)) {
+      out.codegenSeconds = secondsSince(t0);
+      return out;
+    }
+    out.warning = "the LLVM JIT failed (" + out.jit->error + "); running on the bytecode VM instead";
+  }
+  if (loadBytecode(c, out) && backend == Backend::Tiered) addBackgroundJit(c, invariants, out);
+  out.codegenSeconds = secondsSince(t0);
+  return out;
+}
+
+std::optional<rt::TierReport> reportTiers(const RunnableModel& m, bool stats, std::ostream& log) {
+  std::optional<rt::TierReport> tiers = rt::tierReport(m.model.get());
+  if (!tiers) return tiers;
+  const JitOutcome& jit = *m.jit;
+  bool failed = !tiers->compiling && !tiers->ready && !jit.error.empty() && jit.error != "cancelled";
+  if (failed) log << "qdot: warning: the LLVM JIT failed (" << jit.error << "); the run stayed on the bytecode VM\n";
+  if (!stats) return tiers;
+  if (tiers->ready) {
+    log << "jit: native code ready " << tiers->readySeconds * 1e3 << " ms after the VM started; "
+        << tiers->firstTierCalls << " model calls on the VM, " << tiers->secondTierCalls << " on native code\n";
+    printJitStats(jit.stats, log);
+  } else if (!failed) {
+    log << "jit: the run ended before the native code was ready (all " << tiers->firstTierCalls
+        << " model calls on the VM)\n";
+  }
+  return tiers;
+}
+
+void printJitStats(const llvmbackend::JitStats& jit, std::ostream& log) {
+  uint32_t functions = 0;
+  for (uint32_t f : jit.functions) functions += f;
+  log << "jit: " << functions << " functions in " << jit.units << " modules on " << jit.threads << " threads in "
+      << jit.wallSeconds * 1e3 << " ms; lower " << jit.lowerSeconds * 1e3 << " ms, machine code "
+      << jit.codegenSeconds * 1e3 << " ms (summed over threads), link " << jit.linkSeconds * 1e3 << " ms\n";
+}
+
+}  // namespace qdot::driver

@@ -1,0 +1,104 @@
+// `--emit=flat`: the flattened model, one item per line. Variables in index order (time first,
+// then as the flattener created them), each term and equation in the order of the model text.
+#include "flatten/FlatPrinter.h"
+
+#include <charconv>
+#include <ostream>
+
+namespace qdot::flat {
+namespace {
+
+std::string number(double v) {
+  char buf[32];
+  auto res = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, res.ptr);
+}
+
+// "  (utube.qd:14)", or nothing when the item has no place in the text.
+std::string at(const SourceManager& sm, SourceRange r) {
+  std::string line = lineOf(sm, r);
+  return line.empty() ? "" : "   (" + line + ")";
+}
+
+void printVariable(std::ostream& os, const Variable& v, const sym::Context& ctx, const SourceManager& sm) {
+  os << "  " << v.name << ": " << roleName(v.role);
+  if (v.value) os << " = " << sym::toString(ctx, v.value);
+  if (v.start) os << ", start = " << sym::toString(ctx, v.start);
+  if (v.fixed) os << ", fixed";
+  if (v.nominal) os << ", nominal = " << sym::toString(ctx, v.nominal);
+  if (v.min) os << ", min = " << sym::toString(ctx, v.min);
+  if (v.max) os << ", max = " << sym::toString(ctx, v.max);
+  if (!v.unit.empty()) os << ", unit \"" << v.unit << "\"";
+  os << at(sm, v.declRange) << "\n";
+}
+
+void printTerms(std::ostream& os, const char* title, const std::vector<Term>& terms, const sym::Context& ctx,
+                const SourceManager& sm) {
+  os << title << " (" << terms.size() << "):\n";
+  for (const Term& t : terms) os << "  " << sym::toString(ctx, t.value) << at(sm, t.range) << "\n";
+}
+
+void printEquations(std::ostream& os, const char* title, const std::vector<Equation>& equations,
+                    const sym::Context& ctx, const SourceManager& sm) {
+  os << title << " (" << equations.size() << "):\n";
+  for (const Equation& e : equations) {
+    os << "  ";
+    if (e.lhs) os << sym::toString(ctx, e.lhs) << " = " << sym::toString(ctx, e.rhs);
+    else os << sym::toString(ctx, e.residual) << " = 0";
+    os << at(sm, e.origin.range);
+    if (!e.origin.element.empty()) os << " element " << e.origin.element;
+    os << "\n";
+  }
+}
+
+}  // namespace
+
+std::string lineOf(const SourceManager& sm, SourceRange r) {
+  if (!r.valid()) return "";
+  return sm.name(r.file) + ":" + std::to_string(sm.lineCol(r.file, r.begin).line);
+}
+
+void printExperiment(std::ostream& os, const Experiment& e) {
+  os << "experiment:";
+  const std::pair<const char*, const std::optional<double>*> fields[] = {
+      {"StartTime", &e.startTime}, {"StopTime", &e.stopTime}, {"Interval", &e.interval}, {"Tolerance", &e.tolerance}};
+  bool any = false;
+  for (const auto& [name, value] : fields)
+    if (value->has_value()) os << (any ? ", " : " ") << name << " = " << number(**value), any = true;
+  os << (any ? "\n" : " (none)\n");
+}
+
+const char* originKindName(OriginKind k) {
+  switch (k) {
+    case OriginKind::Equation: return "equation";
+    case OriginKind::InitialEquation: return "initial equation";
+    case OriginKind::EulerLagrange: return "Euler-Lagrange row";
+    case OriginKind::Kinematic: return "kinematic";
+    case OriginKind::Constraint: return "constraint";
+  }
+  return "?";
+}
+
+void printFlatModel(std::ostream& os, const FlatModel& m, const sym::Context& ctx, const SourceManager& sm) {
+  os << "flat model " << m.name;
+  if (!m.description.empty()) os << " \"" << m.description << "\"";
+  os << "\n\nvariables (" << m.variables.size() << "):\n";
+  for (const Variable& v : m.variables) printVariable(os, v, ctx, sm);
+  os << "\n";
+  printTerms(os, "kinetic", m.kinetic, ctx, sm);
+  printTerms(os, "potential", m.potential, ctx, sm);
+  printTerms(os, "dissipation", m.dissipation, ctx, sm);
+  os << "forces (" << m.forces.size() << "):\n";
+  for (const auto& [q, t] : m.forces)
+    os << "  force(" << m.variables[q].name << ") = " << sym::toString(ctx, t.value) << at(sm, t.range) << "\n";
+  os << "\n";
+  printEquations(os, "equations", m.equations, ctx, sm);
+  printEquations(os, "initial equations", m.initialEquations, ctx, sm);
+  printEquations(os, "constraints", m.constraints, ctx, sm);
+  os << "outputs (" << m.outputs.size() << "):\n";
+  for (const Output& o : m.outputs) os << "  " << o.name << " = " << sym::toString(ctx, o.value) << at(sm, o.range) << "\n";
+  os << "\n";
+  printExperiment(os, m.experiment);
+}
+
+}  // namespace qdot::flat
