@@ -46,7 +46,11 @@ ModelPtr compileWithSize(const std::string& file, int n) {
     c.diags.render(std::cerr, c.sources);
     throw std::runtime_error("qdot could not compile " + file);
   }
-  kernel::KernelModule kernels = kernel::buildKernels(*c.dae, c.ctx);
+  kernel::KernelModule kernels = kernel::buildKernels(*c.dae, c.ctx, c.diags);
+  if (c.diags.hasErrors()) {
+    c.diags.render(std::cerr, c.sources);
+    throw std::runtime_error("qdot could not compile " + file);
+  }
   bc::Module module = bytecode::emitBytecode(kernels, c.sources);
   std::string error;
   QdotModel* model = vm::createModel(module, error);

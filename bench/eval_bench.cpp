@@ -133,10 +133,10 @@ int main(int argc, char** argv) {
     parse = std::min(parse, t.parse), check = std::min(check, t.check), flatten = std::min(flatten, t.flatten);
     derive = std::min(derive, t.derive), dae = std::min(dae, t.dae);
     auto t0 = Clock::now();
-    kernel::KernelModule kernels = kernel::buildKernels(*c.dae, c.ctx);
+    kernel::KernelModule kernels = kernel::buildKernels(*c.dae, c.ctx, c.diags);
     kernel = std::min(kernel, secondsSince(t0));
-    if (!kernels.errors.empty()) {
-      std::cerr << kernels.errors.front() << "\n";
+    if (c.diags.hasErrors()) {
+      c.diags.render(std::cerr, c.sources);
       return 1;
     }
     instructions = 0;

@@ -48,8 +48,11 @@ Compiled compile(const std::string& file, const std::string& backend, bool invar
   }
   Compiled out;
   auto t0 = Clock::now();
-  kernel::KernelModule kernels = kernel::buildKernels(*c.dae, c.ctx);
-  if (!kernels.errors.empty()) throw std::runtime_error(kernels.errors.front());
+  kernel::KernelModule kernels = kernel::buildKernels(*c.dae, c.ctx, c.diags);
+  if (c.diags.hasErrors()) {
+    c.diags.render(std::cerr, c.sources);
+    throw std::runtime_error("the model has errors");
+  }
   out.kernelSeconds = secondsSince(t0);
   t0 = Clock::now();
   std::string error;

@@ -22,12 +22,12 @@ bool runStages(Compilation& c, uint32_t file, std::string_view model, Stage unti
   c.checked = timed(c.times.check, [&] { return sema::checkModel(*c.ast, model, c.diags); });
   if (!c.checked) {
     if (model.empty()) {
-      c.diags.error({file, 0, 0}, "E0200", "this file declares no model", "declare one: model Name ... end Name;");
+      c.diags.error({file, 0, 0}, DiagCode::E0200, "this file declares no model", "declare one: model Name ... end Name;");
     } else {
       std::string names;
       for (const auto& cls : c.ast->classes)
         if (cls->kind == ast::ClassKind::Model) names += (names.empty() ? "" : ", ") + cls->name;
-      c.diags.error({}, "E0200", "there is no model named '" + std::string(model) + "' in " + c.sources.name(file),
+      c.diags.error({}, DiagCode::E0200, "there is no model named '" + std::string(model) + "' in " + c.sources.name(file),
                     names.empty() ? "the file declares no model" : "the file declares: " + names);
     }
     return false;
@@ -47,7 +47,7 @@ bool compileFile(Compilation& c, const std::string& path, std::string_view model
   uint32_t file = 0;
   std::string error;
   if (!c.sources.addFile(path, file, error)) {
-    c.diags.error({}, "E0001", error, "check the path of the model file");
+    c.diags.error({}, DiagCode::E0001, error, "check the path of the model file");
     return false;
   }
   return runStages(c, file, model, until);

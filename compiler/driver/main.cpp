@@ -166,10 +166,9 @@ int runSimulate(const Options& o) {
   driver::Compilation c;
   if (!driver::compileFile(c, o.file, o.model, driver::Stage::Dae)) return finish(c, false);
   auto t0 = std::chrono::steady_clock::now();
-  kernel::KernelModule kernels = kernel::buildKernels(*c.dae, c.ctx);
+  kernel::KernelModule kernels = kernel::buildKernels(*c.dae, c.ctx, c.diags);
   double kernelSeconds = secondsSince(t0);
-  for (const auto& e : kernels.errors) c.diags.error(c.dae->range, "E0601", e);
-  if (!kernels.errors.empty()) return finish(c, false);
+  if (c.diags.hasErrors()) return finish(c, false);
   if (o.emit == "kernel") {
     kernel::printKernels(std::cout, kernels, &c.sources);
     return finish(c, true);
@@ -267,9 +266,8 @@ int spawnAndWait(const std::vector<std::string>& args) {
 int runBuild(const Options& o) {
   driver::Compilation c;
   if (!driver::compileFile(c, o.file, o.model, driver::Stage::Dae)) return finish(c, false);
-  kernel::KernelModule kernels = kernel::buildKernels(*c.dae, c.ctx);
-  for (const auto& e : kernels.errors) c.diags.error(c.dae->range, "E0601", e);
-  if (!kernels.errors.empty()) return finish(c, false);
+  kernel::KernelModule kernels = kernel::buildKernels(*c.dae, c.ctx, c.diags);
+  if (c.diags.hasErrors()) return finish(c, false);
   bc::Module module = bytecode::emitBytecode(kernels, c.sources);
   std::vector<uint8_t> bytes = bc::serialize(module);
   {  // the bytes must load exactly as the executable will load them

@@ -47,7 +47,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::vector<sym::Expr> residuals;
   for (const auto& e : c.dae->equations) residuals.push_back(e.residual);
   if (c.ctx.dagSize(residuals) > 5'000) return 0;
-  kernel::KernelModule k = kernel::buildKernels(*c.dae, c.ctx);
+  kernel::KernelModule k = kernel::buildKernels(*c.dae, c.ctx, c.diags);
   bc::Module m = bytecode::emitBytecode(k, c.sources);
   std::string error;
   check(bc::validate(m, error));

@@ -28,7 +28,7 @@ class SourceModel : public SourceDae {
   SourceModel(const std::string& name, const std::string& text)
       : SourceDae(name, text) {
     if (!dae) return;
-    kernel = kernel::buildKernels(*dae, ctx);
+    kernel = kernel::buildKernels(*dae, ctx, diags);  // its errors stay in `diags` for the test to inspect
     module = bytecode::emitBytecode(kernel, sources);
     std::string error;
     model = vm::createModel(module, error);

@@ -24,7 +24,8 @@ class KernelSource : public SourceDae {
   KernelSource(const std::string& name, const std::string& text, llvmbackend::JitOptions options = {})
       : SourceDae(name, text) {
     if (!dae) return;
-    kernel = kernel::buildKernels(*dae, ctx);
+    kernel = kernel::buildKernels(*dae, ctx, diags);
+    EXPECT_FALSE(diags.hasErrors());
     options.verifyIR = true;
     std::string error;
     model = llvmbackend::createJitModel(kernel, sources, options, error, &stats);
