@@ -62,7 +62,8 @@ Value Flattener::lower(const ast::Expr& e) {
     case ExprKind::Comprehension: return lowerComprehension(*cast<ComprehensionExpr>(&e));
     case ExprKind::If: return lowerIf(*cast<IfExpr>(&e));
     case ExprKind::End:
-      if (endContext_.empty()) fail(e.range, DiagCode::E0304, "'end' is only allowed inside a subscript");
+      // The parser makes `end` only inside a subscript, and sema rejects it in array sizes.
+      if (endContext_.empty()) QDOT_UNREACHABLE("'end' outside a subscript reached flattening");
       return Value::scalar(ctx_.constant(endContext_.back().first->shape[endContext_.back().second]));
     case ExprKind::String: fail(e.range, DiagCode::E0213, "a string is not allowed here");
     case ExprKind::Member: fail(e.range, DiagCode::E0290, "component member access is not supported yet");

@@ -240,8 +240,7 @@ class Builder {
 
   void reportImplicitInitialEquation(const dae::Equation& e) {
     diags_.error(e.origin.range.valid() ? e.origin.range : dae_.range, DiagCode::E0601,
-                 "an initial equation must give one variable or derivative a value over parameters: "
-                 "v = expression or der(v) = expression",
+                 "an initial equation must read v = expression or der(v) = expression, over parameters",
                  "solve it for the variable by hand, e.g. x = sqrt(4) instead of x^2 = 4, or give the variable a "
                  "start value: Real x(start = 2)");
   }

@@ -19,7 +19,7 @@ const BuiltinFunction kBuiltins[] = {
     {"dot", 2, 2},      {"transpose", 1, 1}, {"diagonal", 1, 1}, {"identity", 1, 1}, {"size", 1, 2},
 };
 
-// Names that parse as calls but belong to features of later issues (events).
+// Names that parse as calls but belong to events, which qdot does not compile.
 bool isEventFunction(std::string_view n) {
   return n == "pre" || n == "reinit" || n == "initial" || n == "edge" || n == "sample" || n == "change";
 }
@@ -39,7 +39,7 @@ class Checker {
     for (const auto& d : m_.cls->declarations) declare(d);
     for (const auto& e : m_.cls->extends)
       diags_.error(e.range, DiagCode::E0290, "'extends' is not supported yet",
-                   "components and inheritance arrive with the components issue; inline the base model");
+                   "inline the base model: copy its declarations and equations into this model");
     for (const auto* d : m_.declarations) checkDeclaration(*d);
     for (const auto& eq : m_.cls->equations) checkEquation(eq);
     for (const auto& eq : m_.cls->initialEquations) checkEquation(eq);
@@ -87,14 +87,14 @@ class Checker {
     std::string t = typeNameOf(d);
     if (t == "Real" || t == "Integer" || t == "Boolean") return true;
     diags_.error(d.typeRange, DiagCode::E0290, "component type '" + t + "' is not supported yet",
-                 "this version compiles flat models: declare Real, Integer or Boolean variables");
+                 "write the component's equations in this model instead, with Real, Integer or Boolean variables");
     return false;
   }
 
   void checkKindRules(const Declaration& d, const ModelSymbol& s) {
     if (d.isFlow)
       diags_.error(d.range, DiagCode::E0290, "'flow' variables are not supported yet",
-                   "connectors arrive with the components issue");
+                   "declare a plain Real and write the balance equation yourself, e.g. i1 + i2 = 0;");
     if (d.causality == Causality::Input)
       diags_.error(d.range, DiagCode::E0290, "'input' variables are not supported yet",
                    "use a parameter, or a definition in terms of time: Real u = sin(time);");
@@ -168,11 +168,12 @@ class Checker {
         return;
       case EquationKind::Connect:
         diags_.error(eq.range, DiagCode::E0290, "'connect' is not supported yet",
-                     "connectors arrive with the components issue");
+                     "write the equations the connection stands for: equal potentials (v1 = v2;) and flows "
+                     "that sum to zero (i1 + i2 = 0;)");
         return;
       case EquationKind::When:
         diags_.error(eq.range, DiagCode::E0290, "'when' equations are not supported yet",
-                     "events arrive with a later issue");
+                     "for a switch that depends on the state, write an if-expression: f = if x > 0 then -k*x else 0;");
         return;
       case EquationKind::If:
         diags_.error(eq.range, DiagCode::E0290, "'if' equations are not supported yet",
@@ -219,7 +220,7 @@ class Checker {
     const std::string& first = n.parts[0];
     if (n.parts.size() > 1) {
       diags_.error(n.range, DiagCode::E0290, "dotted name '" + n.dotted() + "' is not supported yet",
-                   "components arrive with the components issue");
+                   "write the component's variables and equations in this model and use their plain names");
       return;
     }
     if (first == "time" || first == "pi") return;
@@ -240,7 +241,7 @@ class Checker {
                    "pass the arguments by position");
     if (isEventFunction(name)) {
       diags_.error(c.callee->range, DiagCode::E0290, "'" + name + "' is not supported yet",
-                   "events (when, pre, reinit) arrive with a later issue");
+                   "events are not available: write the behaviour as an if-expression in an equation");
       return;
     }
     const BuiltinFunction* f = findBuiltin(name);
@@ -276,7 +277,7 @@ class Checker {
       case ExprKind::Name: return checkName(*cast<NameExpr>(&e));
       case ExprKind::Member:
         diags_.error(e.range, DiagCode::E0290, "component member access is not supported yet",
-                     "components arrive with the components issue");
+                     "write the component's variables and equations in this model and use their plain names");
         return;
       case ExprKind::Index: {
         auto* ix = cast<IndexExpr>(&e);

@@ -176,7 +176,7 @@ end I;
   ASSERT_EQ(m.diags.errorCount(), 1u);
   std::ostringstream rendered;
   m.diags.render(rendered, m.sources);
-  EXPECT_THAT(rendered.str(), HasSubstr("implicit.qd:6:3: error[E0601]: an initial equation must give one variable"));
+  EXPECT_THAT(rendered.str(), HasSubstr("implicit.qd:6:3: error[E0601]: an initial equation must read v = expression"));
 }
 
 TEST(Serialization, RoundTripGivesTheSameModuleAndResults) {
