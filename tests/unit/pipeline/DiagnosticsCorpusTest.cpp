@@ -71,6 +71,16 @@ TEST_P(DiagnosticsCorpus, ReportsExactlyTheExpectedDiagnostics) {
     }
 }
 
+// E0001 is about reading the file itself, so no corpus text can produce it.
+TEST(DiagnosticsOfTheFile, AMissingFileIsReported) {
+  driver::Compilation c;
+  std::string path = std::string(QDOT_SOURCE_DIR) + "/tests/diagnostics/missing.qd";
+  EXPECT_FALSE(driver::compileFile(c, path, "", driver::Stage::Dae));
+  std::ostringstream rendered;
+  c.diags.render(rendered, c.sources);
+  EXPECT_EQ(rendered.str(), "error[E0001]: cannot open file '" + path + "'\nhelp: check the path of the model file\n");
+}
+
 INSTANTIATE_TEST_SUITE_P(Corpus, DiagnosticsCorpus, ::testing::ValuesIn(corpusFiles()),
                          [](const auto& info) {
                            std::string n = info.param.substr(0, info.param.size() - 3);
