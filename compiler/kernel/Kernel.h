@@ -12,9 +12,12 @@
 #include <vector>
 
 #include "dae/Dae.h"
-#include "support/Diagnostic.h"
 #include "support/SourceManager.h"
 #include "symbolic/Expr.h"
+
+namespace qdot {
+class DiagnosticEngine;
+}  // namespace qdot
 
 namespace qdot::kernel {
 

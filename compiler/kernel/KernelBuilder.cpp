@@ -9,6 +9,7 @@
 
 #include "kernel/Jacobian.h"
 #include "kernel/Lowering.h"
+#include "support/Diagnostic.h"
 
 namespace qdot::kernel {
 namespace {

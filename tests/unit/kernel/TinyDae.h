@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "kernel/Kernel.h"
+#include "support/Diagnostic.h"
 
 namespace qdot::test {
 
