@@ -68,7 +68,6 @@ void printHeader(std::ostream& os, const KernelModule& m) {
       os << " " << m.jacobianRowIndices[k];
     os << "\n";
   }
-  for (const auto& e : m.errors) os << "unsupported: " << e << "\n";
 }
 
 }  // namespace
