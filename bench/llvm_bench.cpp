@@ -78,7 +78,11 @@ int main(int argc, char** argv) {
     diags.render(std::cerr, sources);
     return 1;
   }
-  kernel::KernelModule k = kernel::buildKernels(*dae, ctx);
+  kernel::KernelModule k = kernel::buildKernels(*dae, ctx, diags);
+  if (diags.hasErrors()) {
+    diags.render(std::cerr, sources);
+    return 1;
+  }
   double frontEnd = since(t0);
   size_t instructions = 0;
   for (const auto& p : k.programs) instructions += p.code.size();

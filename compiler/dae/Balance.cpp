@@ -98,7 +98,7 @@ bool checkBalance(const Dae& dae, sym::Context& ctx, DiagnosticEngine& diags) {
   for (int v : dm.underVariables)
     if (m.matchOfVariable[v] == structural::kUnmatched) undetermined.push_back(v);
   if (!dm.underVariables.empty()) {
-    auto& d = diags.error(dae.range, neq < nvar ? "E0501" : "E0503",
+    auto& d = diags.error(dae.range, neq < nvar ? DiagCode::E0501 : DiagCode::E0503,
                           (neq < nvar ? "too few equations: " : "structurally singular system: ") + counts +
                               "; nothing determines " + joinNames(dae, undetermined),
                           "add an equation for each of them, or make them parameters or definitions");
@@ -110,7 +110,7 @@ bool checkBalance(const Dae& dae, sym::Context& ctx, DiagnosticEngine& diags) {
     std::vector<int> extra;
     for (int e : dm.overEquations)
       if (m.matchOfEquation[e] == structural::kUnmatched) extra.push_back(e);
-    auto& d = diags.error(dae.range, neq > nvar ? "E0502" : "E0503",
+    auto& d = diags.error(dae.range, neq > nvar ? DiagCode::E0502 : DiagCode::E0503,
                           (neq > nvar ? "too many equations: " : "structurally singular system: ") + counts +
                               (dm.overVariables.empty()
                                    ? "; " + std::to_string(extra.size()) + " equation(s) determine no unknown"

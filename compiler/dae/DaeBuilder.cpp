@@ -32,7 +32,7 @@ class Builder {
     // reduction exists (structural issue); until then the counts must agree.
     if (diags_.errorCount() == errorsBefore && eom_.multipliers.empty()) checkBalance(dae_, ctx_, diags_);
     if (!eom_.multipliers.empty() && dae_.equations.size() != dae_.variables.size())
-      diags_.error(dae_.range, dae_.equations.size() < dae_.variables.size() ? "E0501" : "E0502",
+      diags_.error(dae_.range, dae_.equations.size() < dae_.variables.size() ? DiagCode::E0501 : DiagCode::E0502,
                    std::to_string(dae_.equations.size()) + " equations for " + std::to_string(dae_.variables.size()) +
                        " unknowns");
     if (diags_.errorCount() > errorsBefore) return std::nullopt;

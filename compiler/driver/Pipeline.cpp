@@ -23,13 +23,13 @@ template <class F> auto timed(double& seconds, F&& f) {
 void reportMissingModel(Compilation& c, uint32_t file) {
   const std::string& model = c.options.model;
   if (model.empty()) {
-    c.diags.error({file, 0, 0}, "E0200", "this file declares no model", "declare one: model Name ... end Name;");
+    c.diags.error({file, 0, 0}, DiagCode::E0200, "this file declares no model", "declare one: model Name ... end Name;");
     return;
   }
   std::string names;
   for (const auto& cls : c.ast->classes)
     if (cls->kind == ast::ClassKind::Model) names += (names.empty() ? "" : ", ") + cls->name;
-  c.diags.error({}, "E0200", "there is no model named '" + model + "' in " + c.sources.name(file),
+  c.diags.error({}, DiagCode::E0200, "there is no model named '" + model + "' in " + c.sources.name(file),
                 names.empty() ? "the file declares no model" : "the file declares: " + names);
 }
 
@@ -60,11 +60,9 @@ bool buildDae(Compilation& c) {
 }
 
 bool buildKernels(Compilation& c) {
-  auto kernels = timed(c.times.kernel, [&] {
-    return std::make_shared<const kernel::KernelModule>(kernel::buildKernels(*c.dae, c.ctx));
+  c.kernels = timed(c.times.kernel, [&] {
+    return std::make_shared<const kernel::KernelModule>(kernel::buildKernels(*c.dae, c.ctx, c.diags));
   });
-  for (const auto& e : kernels->errors) c.diags.error(c.dae->range, "E0601", e);
-  c.kernels = std::move(kernels);
   return !c.diags.hasErrors();
 }
 
@@ -125,7 +123,7 @@ bool compileFile(Compilation& c, const std::string& path, Stage until) {
     std::string text(std::istreambuf_iterator<char>(std::cin), {});
     file = c.sources.addBuffer("<stdin>", std::move(text));
   } else if (std::string error; !c.sources.addFile(path, file, error)) {
-    c.diags.error({}, "E0001", error, "check the path of the model file");
+    c.diags.error({}, DiagCode::E0001, error, "check the path of the model file");
     return c.ok = false;
   }
   return startFrom(c, file, until);

@@ -62,7 +62,7 @@ Value Flattener::lowerCall(const CallExpr& e) {
   if (name == "sum" || name == "product") return lowerReduction(e, name == "sum");
   if ((name == "min" || name == "max") && e.args.size() == 1) {
     Value v = arg(0);
-    if (v.elems.empty()) fail(e.range, "E0309", "'" + name + "' of an empty array");
+    if (v.elems.empty()) fail(e.range, DiagCode::E0309, "'" + name + "' of an empty array");
     Expr r = v.elems[0];
     for (size_t i = 1; i < v.size(); ++i) r = ctx_.binary(name == "min" ? Kind::Min : Kind::Max, r, v.elems[i]);
     return Value::scalar(r);
@@ -71,7 +71,7 @@ Value Flattener::lowerCall(const CallExpr& e) {
     Kind k = name == "min" ? Kind::Min : name == "max" ? Kind::Max : Kind::Atan2;
     Value a = arg(0), b = arg(1);
     if (a.shape != b.shape)
-      fail(e.range, "E0307", "'" + name + "' needs arguments of the same shape, got " + shapeText(a.shape) +
+      fail(e.range, DiagCode::E0307, "'" + name + "' needs arguments of the same shape, got " + shapeText(a.shape) +
                                  " and " + shapeText(b.shape));
     for (size_t i = 0; i < a.size(); ++i) a.elems[i] = ctx_.binary(k, a.elems[i], b.elems[i]);
     return a;
@@ -94,7 +94,7 @@ Value Flattener::lowerReduction(const CallExpr& e, bool isSum) {
   for (size_t k = 0; k < r.size(); ++k) {
     for (size_t i = 0; i < parts.size(); ++i) {
       if (parts[i].shape != r.shape)
-        fail(e.range, "E0307", "the terms of this reduction have different shapes");
+        fail(e.range, DiagCode::E0307, "the terms of this reduction have different shapes");
       column[i] = parts[i].elems[k];
     }
     r.elems[k] = isSum ? ctx_.add(column) : ctx_.mul(column);
@@ -108,7 +108,7 @@ Value Flattener::lowerArrayBuiltin(const std::string& name, const CallExpr& e) {
     std::vector<int> dims;
     for (size_t i = first; i < e.args.size(); ++i) {
       long n = lowerInteger(*e.args[i], "an array size");
-      if (n < 0) fail(e.args[i]->range, "E0303", "an array size cannot be negative");
+      if (n < 0) fail(e.args[i]->range, DiagCode::E0303, "an array size cannot be negative");
       dims.push_back(static_cast<int>(n));
     }
     return dims;
@@ -130,7 +130,7 @@ Value Flattener::lowerArrayBuiltin(const std::string& name, const CallExpr& e) {
   }
   if (name == "diagonal") {
     Value d = arg(0);
-    if (d.shape.size() != 1) fail(e.args[0]->range, "E0307", "diagonal() takes a vector");
+    if (d.shape.size() != 1) fail(e.args[0]->range, DiagCode::E0307, "diagonal() takes a vector");
     int n = d.shape[0];
     Value v = filled({n, n}, ctx_.zero());
     for (int i = 0; i < n; ++i) v.elems[i * n + i] = d.elems[i];
@@ -138,7 +138,7 @@ Value Flattener::lowerArrayBuiltin(const std::string& name, const CallExpr& e) {
   }
   if (name == "transpose") {
     Value m = arg(0);
-    if (m.shape.size() != 2) fail(e.args[0]->range, "E0307", "transpose() takes a matrix, got " + shapeText(m.shape));
+    if (m.shape.size() != 2) fail(e.args[0]->range, DiagCode::E0307, "transpose() takes a matrix, got " + shapeText(m.shape));
     Value t{{m.shape[1], m.shape[0]}, ExprList(m.size(), nullptr)};
     for (int i = 0; i < m.shape[0]; ++i)
       for (int j = 0; j < m.shape[1]; ++j) t.elems[j * m.shape[0] + i] = m.elems[i * m.shape[1] + j];
@@ -148,7 +148,7 @@ Value Flattener::lowerArrayBuiltin(const std::string& name, const CallExpr& e) {
     Value a = arg(0), b = arg(1);
     bool ok = a.shape.size() == 1 && a.shape == b.shape && (name == "dot" || a.shape[0] == 3);
     if (!ok)
-      fail(e.range, "E0307", name + "() needs two vectors of " + (name == "dot" ? "equal length" : "length 3") +
+      fail(e.range, DiagCode::E0307, name + "() needs two vectors of " + (name == "dot" ? "equal length" : "length 3") +
                                  ", got " + shapeText(a.shape) + " and " + shapeText(b.shape));
     if (name == "dot") {
       std::vector<Expr> t;
@@ -163,14 +163,14 @@ Value Flattener::lowerArrayBuiltin(const std::string& name, const CallExpr& e) {
     if (e.args.size() == 2) {
       long d = lowerInteger(*e.args[1], "the dimension of size()");
       if (d < 1 || d > static_cast<long>(a.shape.size()))
-        fail(e.args[1]->range, "E0301", "dimension " + std::to_string(d) + " is out of range for " + shapeText(a.shape));
+        fail(e.args[1]->range, DiagCode::E0301, "dimension " + std::to_string(d) + " is out of range for " + shapeText(a.shape));
       return Value::scalar(ctx_.constant(a.shape[d - 1]));
     }
     Value v{{static_cast<int>(a.shape.size())}, {}};
     for (int d : a.shape) v.elems.push_back(ctx_.constant(d));
     return v;
   }
-  fail(e.callee->range, "E0210", "unknown function '" + name + "'");
+  fail(e.callee->range, DiagCode::E0210, "unknown function '" + name + "'");
 }
 
 }  // namespace qdot::flat

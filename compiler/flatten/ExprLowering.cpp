@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "flatten/Flattener.h"
+#include "support/Assert.h"
 
 namespace qdot::flat {
 
@@ -20,22 +21,22 @@ std::string shapeText(const std::vector<int>& shape) {
   return s + "]";
 }
 
-void Flattener::fail(SourceRange r, std::string code, std::string msg, std::string help) {
-  diags_.error(r, std::move(code), std::move(msg), std::move(help));
+void Flattener::fail(SourceRange r, DiagCode code, std::string msg, std::string help) {
+  diags_.error(r, code, std::move(msg), std::move(help));
   throw FlattenAbort{};
 }
 
 Expr Flattener::lowerScalar(const ast::Expr& e, const char* what) {
   Value v = lower(e);
   if (!v.isScalar())
-    fail(e.range, "E0302", std::string(what) + " must be a scalar, but this is an array of shape " + shapeText(v.shape));
+    fail(e.range, DiagCode::E0302, std::string(what) + " must be a scalar, but this is an array of shape " + shapeText(v.shape));
   return v.elems[0];
 }
 
 double Flattener::lowerConstant(const ast::Expr& e, const char* what) {
   Expr x = lowerScalar(e, what);
   if (!x->isConstant())
-    fail(e.range, "E0303", std::string(what) + " must be known at compile time",
+    fail(e.range, DiagCode::E0303, std::string(what) + " must be known at compile time",
          "use literals, constants and Integer parameters here");
   return x->value;
 }
@@ -43,7 +44,7 @@ double Flattener::lowerConstant(const ast::Expr& e, const char* what) {
 long Flattener::lowerInteger(const ast::Expr& e, const char* what) {
   double v = lowerConstant(e, what);
   if (v != std::floor(v) || std::fabs(v) > 1e9)
-    fail(e.range, "E0303", std::string(what) + " must be an Integer, but it is " + sym::toString(ctx_, ctx_.constant(v)));
+    fail(e.range, DiagCode::E0303, std::string(what) + " must be an Integer, but it is " + sym::toString(ctx_, ctx_.constant(v)));
   return static_cast<long>(v);
 }
 
@@ -61,12 +62,13 @@ Value Flattener::lower(const ast::Expr& e) {
     case ExprKind::Comprehension: return lowerComprehension(*cast<ComprehensionExpr>(&e));
     case ExprKind::If: return lowerIf(*cast<IfExpr>(&e));
     case ExprKind::End:
-      if (endContext_.empty()) fail(e.range, "E0304", "'end' is only allowed inside a subscript");
+      // The parser makes `end` only inside a subscript, and sema rejects it in array sizes.
+      if (endContext_.empty()) QDOT_UNREACHABLE("'end' outside a subscript reached flattening");
       return Value::scalar(ctx_.constant(endContext_.back().first->shape[endContext_.back().second]));
-    case ExprKind::String: fail(e.range, "E0213", "a string is not allowed here");
-    case ExprKind::Member: fail(e.range, "E0290", "component member access is not supported yet");
+    case ExprKind::String: fail(e.range, DiagCode::E0213, "a string is not allowed here");
+    case ExprKind::Member: fail(e.range, DiagCode::E0290, "component member access is not supported yet");
   }
-  fail(e.range, "E0399", "unsupported expression");
+  QDOT_UNREACHABLE("lower: every expression kind is handled in the switch");
 }
 
 Value Flattener::lowerName(const NameExpr& n) {
@@ -77,7 +79,7 @@ Value Flattener::lowerName(const NameExpr& n) {
   if (s != m_.symbols.end()) return valueOf(*s->second.decl, n.range);
   if (name == "time") return Value::scalar(out_.time());
   if (name == "pi") return Value::scalar(ctx_.constant(std::numbers::pi));
-  fail(n.range, "E0202", "unknown name '" + name + "'");
+  fail(n.range, DiagCode::E0202, "unknown name '" + name + "'");
 }
 
 // `end` inside subscript `dim` of `base` means the size of that dimension while this lives.
@@ -96,7 +98,7 @@ class Flattener::EndScope {
 
 void Flattener::checkIndex(int i, int dimSize, const ast::Expr& s) {
   if (i < 1 || i > dimSize)
-    fail(s.range, "E0301", "index " + std::to_string(i) + " is out of range 1:" + std::to_string(dimSize),
+    fail(s.range, DiagCode::E0301, "index " + std::to_string(i) + " is out of range 1:" + std::to_string(dimSize),
          "array indices start at 1 and end at the size of the dimension");
 }
 
@@ -137,7 +139,7 @@ Value Flattener::lowerIndex(const IndexExpr& e) {
   Value holder;
   const Value& base = subscriptBase(*e.base, holder);
   if (e.subscripts.size() != base.shape.size())
-    fail(e.range, "E0305",
+    fail(e.range, DiagCode::E0305,
          std::to_string(e.subscripts.size()) + " subscript(s) given for an array of shape " + shapeText(base.shape),
          base.shape.empty() ? "this is a scalar: remove the subscript" : "give one subscript per dimension");
   auto isRange = [](const ExprPtr& s) { return dyn_cast<RangeExpr>(s.get()) != nullptr; };
@@ -203,7 +205,7 @@ Value Flattener::lowerBinary(const BinaryExpr& e) {
     default: break;
   }
   if (!a.isScalar() || !b.isScalar())
-    fail(e.opRange, "E0306", std::string("'") + spelling(e.op) + "' needs scalar operands, but got " +
+    fail(e.opRange, DiagCode::E0306, std::string("'") + spelling(e.op) + "' needs scalar operands, but got " +
                                  shapeText(a.shape) + " and " + shapeText(b.shape));
   Expr x = a.elems[0], y = b.elems[0];
   switch (e.op) {
@@ -217,18 +219,18 @@ Value Flattener::lowerBinary(const BinaryExpr& e) {
     case BinaryOp::Or: return Value::scalar(ctx_.binary(Kind::Or, x, y));
     default: break;
   }
-  fail(e.opRange, "E0399", "unsupported operator");
+  QDOT_UNREACHABLE("lowerBinary: every binary operator is handled in the switches");
 }
 
 // + and - need equal shapes; / needs a scalar divisor; ^ needs scalars (Modelica's rules).
 Value Flattener::lowerArithmetic(BinaryOp op, Value a, Value b, const BinaryExpr& e) {
   std::string opText = spelling(op);
   if ((op == BinaryOp::Div || op == BinaryOp::Pow) && !b.isScalar())
-    fail(e.rhs->range, "E0306", "the right operand of '" + opText + "' must be a scalar, but it has shape " + shapeText(b.shape));
+    fail(e.rhs->range, DiagCode::E0306, "the right operand of '" + opText + "' must be a scalar, but it has shape " + shapeText(b.shape));
   if (op == BinaryOp::Pow && !a.isScalar())
-    fail(e.lhs->range, "E0306", "'^' of an array is not supported", "raise each element: {x[i]^2 for i in 1:n}");
+    fail(e.lhs->range, DiagCode::E0306, "'^' of an array is not supported", "raise each element: {x[i]^2 for i in 1:n}");
   if ((op == BinaryOp::Add || op == BinaryOp::Sub) && a.shape != b.shape)
-    fail(e.opRange, "E0307", "shape mismatch: " + shapeText(a.shape) + " " + opText + " " + shapeText(b.shape),
+    fail(e.opRange, DiagCode::E0307, "shape mismatch: " + shapeText(a.shape) + " " + opText + " " + shapeText(b.shape),
          "both operands of '" + opText + "' must have the same shape");
   for (size_t i = 0; i < a.size(); ++i) {
     Expr y = b.isScalar() ? b.elems[0] : b.elems[i];
@@ -254,7 +256,7 @@ Value Flattener::lowerProduct(Value a, Value b, const BinaryExpr& e) {
   int inner = a.shape.back();
   int innerB = b.shape[0];
   if (a.shape.size() > 2 || b.shape.size() > 2 || inner != innerB)
-    fail(e.opRange, "E0307", "cannot multiply " + shapeText(a.shape) + " by " + shapeText(b.shape),
+    fail(e.opRange, DiagCode::E0307, "cannot multiply " + shapeText(a.shape) + " by " + shapeText(b.shape),
          "inner dimensions must agree (matrix*vector, vector*vector, matrix*matrix)");
   int n = a.shape.size() == 2 ? rows(a) : 1;
   int p = b.shape.size() == 2 ? b.shape[1] : 1;
@@ -281,14 +283,14 @@ std::vector<Expr> Flattener::iterationValues(const ast::Expr& range) {
   auto* r = dyn_cast<RangeExpr>(&range);
   if (!r) {
     Value v = lower(range);
-    if (v.shape.size() != 1) fail(range.range, "E0308", "a loop range must be a vector, e.g. 1:n");
+    if (v.shape.size() != 1) fail(range.range, DiagCode::E0308, "a loop range must be a vector, e.g. 1:n");
     return {v.elems.begin(), v.elems.end()};
   }
-  if (!r->start || !r->stop) fail(range.range, "E0308", "a loop range needs a start and a stop, e.g. 1:n");
+  if (!r->start || !r->stop) fail(range.range, DiagCode::E0308, "a loop range needs a start and a stop, e.g. 1:n");
   double a = lowerConstant(*r->start, "a range bound");
   double step = r->step ? lowerConstant(*r->step, "a range step") : 1.0;
   double b = lowerConstant(*r->stop, "a range bound");
-  if (step == 0) fail(r->step->range, "E0308", "a range step cannot be 0");
+  if (step == 0) fail(r->step->range, DiagCode::E0308, "a range step cannot be 0");
   double count = std::floor((b - a) / step + 1e-9) + 1;
   if (!(count > 0)) return {};
   countScalars(static_cast<size_t>(count), range.range);
@@ -303,7 +305,7 @@ Value Flattener::stack(std::vector<Value> parts, SourceRange r) {
   if (parts.empty()) return v;
   for (size_t i = 1; i < parts.size(); ++i)
     if (parts[i].shape != parts[0].shape)
-      fail(r, "E0307", "array elements have different shapes: " + shapeText(parts[0].shape) + " and " +
+      fail(r, DiagCode::E0307, "array elements have different shapes: " + shapeText(parts[0].shape) + " and " +
                            shapeText(parts[i].shape));
   v.shape.insert(v.shape.end(), parts[0].shape.begin(), parts[0].shape.end());
   for (auto& p : parts) v.elems.append(p.elems);
@@ -341,7 +343,7 @@ Value Flattener::lowerIf(const IfExpr& e) {
   for (size_t i = conds.size(); i-- > 0;) {
     Value branch = lower(*e.values[i]);
     if (branch.shape != result.shape)
-      fail(e.values[i]->range, "E0307", "the branches of this if-expression have different shapes: " +
+      fail(e.values[i]->range, DiagCode::E0307, "the branches of this if-expression have different shapes: " +
                                             shapeText(branch.shape) + " and " + shapeText(result.shape));
     for (size_t k = 0; k < result.size(); ++k)
       result.elems[k] = ctx_.select(conds[i], branch.elems[k], result.elems[k]);

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "flatten/Flattener.h"
+#include "support/Assert.h"
 
 namespace qdot::flat {
 
@@ -97,7 +98,7 @@ std::optional<FlatModel> Flattener::run() {
 void Flattener::countScalars(size_t n, SourceRange r) {
   scalars_ += n;
   if (scalars_ > limits_.maxScalars)
-    fail(r, "E0310", "the model expands to more than " + std::to_string(limits_.maxScalars) + " scalars",
+    fail(r, DiagCode::E0310, "the model expands to more than " + std::to_string(limits_.maxScalars) + " scalars",
          "reduce the array sizes or loop ranges");
 }
 
@@ -122,7 +123,7 @@ int Flattener::derivativeVariable(int var, SourceRange where) {
                     : role == VarRole::Unknown  ? VarRole::Derivative
                                                 : VarRole::Time;
   if (derRole == VarRole::Time)
-    fail(where, "E0311",
+    fail(where, DiagCode::E0311,
          "cannot take the derivative of '" + std::string(out_.variables[var].name) + "' (a " + roleName(role) + ")",
          "higher derivatives are only available for coordinates: declare the variable as 'coordinate Real'");
   Expr symbol = ctx_.symbol("der(" + std::string(out_.variables[var].name) + ")");
@@ -137,7 +138,7 @@ const Value& Flattener::valueOf(const Declaration& d, SourceRange use) {
   if (auto it = declValues_.find(&d); it != declValues_.end()) return it->second;
   if (failed_.count(&d)) throw FlattenAbort{};
   if (!inProgress_.insert(&d).second)
-    fail(use, "E0312", "the definition of '" + d.name + "' depends on itself",
+    fail(use, DiagCode::E0312, "the definition of '" + d.name + "' depends on itself",
          "break the cycle: a definition or parameter cannot refer to itself, directly or through others");
   Value v;
   try {
@@ -157,7 +158,7 @@ std::vector<int> Flattener::evaluateDims(const Declaration& d) {
   for (const auto* dims : {&d.typeDims, &d.dims})
     for (const auto& e : *dims) {
       long n = lowerInteger(*e, "an array size");
-      if (n < 0) fail(e->range, "E0303", "array size " + std::to_string(n) + " is negative");
+      if (n < 0) fail(e->range, DiagCode::E0303, "array size " + std::to_string(n) + " is negative");
       shape.push_back(static_cast<int>(n));
       total *= static_cast<size_t>(n);
       countScalars(static_cast<size_t>(n), e->range);
@@ -174,10 +175,10 @@ Value Flattener::createDeclaration(const Declaration& d, const sema::ModelSymbol
       Value v = bindingValue(d, shape);
       for (size_t i = 0; i < v.size(); ++i)
         if (!v.elems[i]->isConstant())
-          fail(d.binding->range, "E0313", "the value of '" + d.name + "' must be known at compile time",
+          fail(d.binding->range, DiagCode::E0313, "the value of '" + d.name + "' must be known at compile time",
                "constants and Integer parameters may only depend on literals and other constants");
         else if (s.kind == SymbolKind::IntegerParameter && v.elems[i]->value != std::floor(v.elems[i]->value))
-          fail(d.binding->range, "E0313", "Integer parameter '" + d.name + "' has a non-integer value");
+          fail(d.binding->range, DiagCode::E0313, "Integer parameter '" + d.name + "' has a non-integer value");
       return v;
     }
     case SymbolKind::Definition: {
@@ -205,7 +206,7 @@ Value Flattener::createDeclaration(const Declaration& d, const sema::ModelSymbol
       return vars;
     }
   }
-  fail(d.range, "E0399", "unsupported declaration");
+  QDOT_UNREACHABLE("createDeclaration: every symbol kind is handled in the switch");
 }
 
 // Room for `count` more variables, growing geometrically (reserving exactly per declaration would
@@ -231,7 +232,7 @@ Value Flattener::variablesFor(const Declaration& d, const std::vector<int>& shap
 
 void Flattener::checkShape(const Value& v, const std::vector<int>& shape, SourceRange r, const std::string& what) {
   if (v.shape != shape)
-    fail(r, "E0307", what + " has shape " + shapeText(v.shape) + ", but " + shapeText(shape) + " is needed",
+    fail(r, DiagCode::E0307, what + " has shape " + shapeText(v.shape) + ", but " + shapeText(shape) + " is needed",
          shape.empty() ? "give a scalar value" : "give an array of shape " + shapeText(shape) + ", e.g. with fill(value, ...)");
 }
 
@@ -261,7 +262,7 @@ void Flattener::applyAttributes(const Declaration& d, const Value& vars) {
       else if (mod.name == "nominal") var.nominal = x;
       else if (mod.name == "min") var.min = x;
       else if (mod.name == "max") var.max = x;
-      else if (!x->isConstant()) fail(mod.value->range, "E0303", "'fixed' must be true or false");
+      else if (!x->isConstant()) fail(mod.value->range, DiagCode::E0303, "'fixed' must be true or false");
       else var.fixed = x->value != 0;
     }
   }
@@ -278,7 +279,7 @@ void Flattener::lowerEquation(const ast::Equation& eq, std::vector<flat::Equatio
   Value l = lower(*eq.lhs);
   Value r = lower(*eq.rhs);
   if (l.shape != r.shape)
-    fail(eq.range, "E0307", "the two sides of this equation have different shapes: " + shapeText(l.shape) +
+    fail(eq.range, DiagCode::E0307, "the two sides of this equation have different shapes: " + shapeText(l.shape) +
                                 " and " + shapeText(r.shape));
   countScalars(l.size(), eq.range);
   for (size_t i = 0; i < l.size(); ++i) {
@@ -300,7 +301,7 @@ void Flattener::lowerMechanics(const MechanicsStmt& st) {
     case MechanicsKind::Force: return lowerForce(st);
     case MechanicsKind::Constraint: {
       Value l = lower(*st.value), r = lower(*st.rhs);
-      if (l.shape != r.shape) fail(st.range, "E0307", "the two sides of this constraint have different shapes");
+      if (l.shape != r.shape) fail(st.range, DiagCode::E0307, "the two sides of this constraint have different shapes");
       for (size_t i = 0; i < l.size(); ++i)
         out_.constraints.push_back(
             {ctx_.sub(l.elems[i], r.elems[i]), {OriginKind::Constraint, st.range, -1, ""}, l.elems[i], r.elems[i]});
@@ -319,12 +320,12 @@ void Flattener::lowerForce(const MechanicsStmt& st) {
   Value target = lower(*st.target);
   Value value = lower(*st.value);
   if (target.shape != value.shape)
-    fail(st.value->range, "E0307", "the force has shape " + shapeText(value.shape) + " but its coordinate has shape " +
+    fail(st.value->range, DiagCode::E0307, "the force has shape " + shapeText(value.shape) + " but its coordinate has shape " +
                                        shapeText(target.shape));
   for (size_t i = 0; i < target.size(); ++i) {
     int var = out_.variableOf(target.elems[i]);
     if (var < 0 || out_.variables[var].role != VarRole::Coordinate)
-      fail(st.target->range, "E0209", "force(...) must name a coordinate");
+      fail(st.target->range, DiagCode::E0209, "force(...) must name a coordinate");
     out_.forces.push_back({var, {value.elems[i], st.range}});
   }
 }
@@ -341,7 +342,7 @@ void Flattener::lowerExperiment() {
                                       : m.name == "Tolerance" ? &out_.experiment.tolerance
                                                               : nullptr;
         if (!slot) {
-          diags_.warning(m.nameRange, "W0301", "unknown experiment setting '" + m.name + "' is ignored",
+          diags_.warning(m.nameRange, DiagCode::W0301, "unknown experiment setting '" + m.name + "' is ignored",
                          "the settings are StartTime, StopTime, Interval and Tolerance");
           continue;
         }

@@ -98,7 +98,7 @@ class Flattener {
   sym::Expr timeDerivative(sym::Expr e, SourceRange where);
   sym::Expr rateOf(sym::Expr symbol);
 
-  [[noreturn]] void fail(SourceRange r, std::string code, std::string msg, std::string help = {});
+  [[noreturn]] void fail(SourceRange r, DiagCode code, std::string msg, std::string help = {});
 
  private:
   const sema::CheckedModel& m_;

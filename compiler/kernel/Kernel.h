@@ -16,6 +16,10 @@
 #include "support/SourceManager.h"
 #include "symbolic/Expr.h"
 
+namespace qdot {
+class DiagnosticEngine;
+}  // namespace qdot
+
 namespace qdot::kernel {
 
 /// The opcodes of qdot/opcodes.def (the same numbering as qdot::bc::Opcode).
@@ -60,8 +64,7 @@ struct KernelModule {
   /// residual: out = F (n). jacobian: out = values in CSC order. outputs, invariants: one each.
   PerProgram<Program> programs;
   std::vector<Source> sources;
-  size_t sharedTemporaries = 0;     ///< CSE temporaries of residual + Jacobian together
-  std::vector<std::string> errors;  ///< constructs not supported yet (e.g. implicit initial equations)
+  size_t sharedTemporaries = 0;  ///< CSE temporaries of residual + Jacobian together
 
   Program& program(ModelProgram p) { return programs[programIndex(p)]; }
   const Program& program(ModelProgram p) const { return programs[programIndex(p)]; }
@@ -69,9 +72,11 @@ struct KernelModule {
 };
 
 /// Builds every program of the model. `ctx` must be the Context the Dae's expressions live in
-/// (differentiation and CSE create nodes and the symbols `$cj` and `$t<k>`). Unsupported
-/// constructs are listed in `errors` (their values become NaN); the module is complete otherwise.
-KernelModule buildKernels(const dae::Dae& dae, sym::Context& ctx);
+/// (differentiation and CSE create nodes and the symbols `$cj` and `$t<k>`). What the programs
+/// cannot compute (an implicit initial equation, a value used where it is not available) is
+/// reported to `diags` at the equation or declaration concerned, and that value becomes NaN; the
+/// module is complete otherwise, so a caller must check `diags.hasErrors()` before running it.
+KernelModule buildKernels(const dae::Dae& dae, sym::Context& ctx, DiagnosticEngine& diags);
 
 /// `--emit=kernel`: deterministic text of the module. With a SourceManager, sources show file:line.
 void printKernels(std::ostream& os, const KernelModule& m, const SourceManager* sm = nullptr);

@@ -9,6 +9,7 @@
 
 #include "kernel/Jacobian.h"
 #include "kernel/Lowering.h"
+#include "support/Diagnostic.h"
 
 namespace qdot::kernel {
 namespace {
@@ -22,7 +23,7 @@ std::string shorten(std::string s, size_t max = 120) {
 
 class Builder {
  public:
-  Builder(const dae::Dae& dae, sym::Context& ctx) : dae_(dae), ctx_(ctx) {}
+  Builder(const dae::Dae& dae, sym::Context& ctx, DiagnosticEngine& diags) : dae_(dae), ctx_(ctx), diags_(diags) {}
 
   KernelModule run() {
     describeModel();
@@ -39,6 +40,7 @@ class Builder {
   const dae::Dae& dae_;
   std::unordered_map<int, std::string> nameOfFlat_;
   sym::Context& ctx_;
+  DiagnosticEngine& diags_;
   KernelModule m_;
   std::vector<uint32_t> equationSource_;
 
@@ -122,9 +124,13 @@ class Builder {
     }
   }
 
-  void reportUnbound(const ProgramBuilder& b, const std::string& where) {
-    for (Expr s : b.unboundSymbols())
-      m_.errors.push_back(where + ": '" + ctx_.symbolName(s) + "' is not available there (its value is NaN)");
+  // A symbol no input binds: at the source that used it (the model's line if that has no location).
+  void reportUnbound(const ProgramBuilder& b, const std::string& where, const char* help) {
+    for (const auto& use : b.unboundSymbols()) {
+      SourceRange r = use.source < m_.sources.size() ? m_.sources[use.source].range : SourceRange{};
+      diags_.error(r.valid() ? r : dae_.range, DiagCode::E0602,
+                   "'" + ctx_.symbolName(use.symbol) + "' is not available in the " + where, help);
+    }
   }
 
   // --- parameters ------------------------------------------------------------------------------
@@ -173,7 +179,10 @@ class Builder {
       std::string text = p.value ? p.name + " = " + sym::toString(ctx_, p.value) : std::string();
       b.setSource(addSource("parameter " + p.name, p.declRange, text));
       bool usable = p.value && !cyclic_.count(k);
-      if (cyclic_.count(k)) m_.errors.push_back("parameter " + p.name + ": its binding depends on itself");
+      if (cyclic_.count(k))
+        diags_.error(p.declRange.valid() ? p.declRange : dae_.range, DiagCode::E0312,
+                     "the value of parameter '" + p.name + "' depends on itself",
+                     "break the cycle: a parameter cannot refer to itself, directly or through others");
       uint32_t given = b.emit(Op::LoadGiven, 0, 0, 0, k);
       uint32_t overridden = b.emit(Op::LoadOverridden, 0, 0, 0, k);
       uint32_t fallback = usable ? b.lower(p.value) : b.constant(nan);
@@ -181,7 +190,7 @@ class Builder {
       b.bindRegister(p.symbol, value);
       b.store(k, value);
     }
-    reportUnbound(b, "parameter bindings");
+    reportUnbound(b, "parameter bindings", "a parameter's value may use only literals, constants and other parameters");
     m_.program(ModelProgram::Parameters) = b.finish(static_cast<uint32_t>(dae_.parameters.size()));
   }
 
@@ -228,12 +237,15 @@ class Builder {
       if (v.declaration.start) starts[j].source = addSource("start value of " + v.name, v.declaration.declRange);
     }
     for (size_t i = 0; i < dae_.initialEquations.size(); ++i)
-      if (!applyInitialEquation(i, starts))
-        m_.errors.push_back("initial equation " + std::to_string(i + 1) + " (" +
-                            equationText(dae_.initialEquations[i]) +
-                            "): only `variable = expression` or `der(variable) = expression` over parameters "
-                            "is supported for now");
+      if (!applyInitialEquation(i, starts)) reportImplicitInitialEquation(dae_.initialEquations[i]);
     return starts;
+  }
+
+  void reportImplicitInitialEquation(const dae::Equation& e) {
+    diags_.error(e.origin.range.valid() ? e.origin.range : dae_.range, DiagCode::E0601,
+                 "an initial equation must read v = expression or der(v) = expression, over parameters",
+                 "solve it for the variable by hand, e.g. x = sqrt(4) instead of x^2 = 4, or give the variable a "
+                 "start value: Real x(start = 2)");
   }
 
   // out = [y0 (n), yp0 (n), nominal (n)]; stores of a plain 0 serve no source.
@@ -253,7 +265,7 @@ class Builder {
       sym::Expr nominal = v.declaration.nominal;
       store(2 * n + j, nominal, nominal ? addSource("nominal value of " + v.name, v.declaration.declRange) : UINT32_MAX);
     }
-    reportUnbound(b, "start values (only parameters may be used)");
+    reportUnbound(b, "start values", "a start value may use only literals, constants, parameters and time");
     m_.program(ModelProgram::InitialValues) = b.finish(3 * n);
   }
 
@@ -275,7 +287,7 @@ class Builder {
     bindInputs(res, true);
     for (const auto& [t, value] : cse.temporaries) res.bindTemporary(t, value);
     for (uint32_t i = 0; i < n; ++i) res.setSource(equationSource_[i]), res.store(i, res.lower(cse.outputs[i]));
-    reportUnbound(res, "residual");
+    reportUnbound(res, "residual", "declare it as a variable or a parameter");
     m_.program(ModelProgram::Residual) = res.finish(static_cast<uint32_t>(n));
 
     ProgramBuilder jb(programName(ModelProgram::Jacobian));
@@ -296,7 +308,7 @@ class Builder {
     bindInputs(b, true);
     for (const auto& [t, value] : cse.temporaries) b.bindTemporary(t, value);
     for (uint32_t i = 0; i < values.size(); ++i) b.setSource(sources[i]), b.store(i, b.lower(cse.outputs[i]));
-    reportUnbound(b, programName(program));
+    reportUnbound(b, programName(program), "declare it as a variable or a parameter");
     return b.finish(static_cast<uint32_t>(values.size()));
   }
 
@@ -323,6 +335,8 @@ class Builder {
 
 }  // namespace
 
-KernelModule buildKernels(const dae::Dae& dae, sym::Context& ctx) { return Builder(dae, ctx).run(); }
+KernelModule buildKernels(const dae::Dae& dae, sym::Context& ctx, DiagnosticEngine& diags) {
+  return Builder(dae, ctx, diags).run();
+}
 
 }  // namespace qdot::kernel

@@ -69,7 +69,6 @@ void printHeader(std::ostream& os, const KernelModule& m) {
       os << " " << d.jacobianRowIndices[k];
     os << "\n";
   }
-  for (const auto& e : m.errors) os << "unsupported: " << e << "\n";
 }
 
 }  // namespace

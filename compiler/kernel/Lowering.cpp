@@ -143,7 +143,7 @@ uint32_t ProgramBuilder::emitNode(sym::Expr e) {
 uint32_t ProgramBuilder::emitSymbol(sym::Expr e) {
   if (sym::Expr t = find(temporaries_, e, sym::Expr{nullptr})) return reg(t);
   if (Load l = find(loads_, e, kNoLoad); l.second != kNone) return emit(l.first, 0, 0, 0, l.second);
-  unbound_.push_back(e);
+  unbound_.push_back({e, source_});
   return constant(std::numeric_limits<double>::quiet_NaN());
 }
 

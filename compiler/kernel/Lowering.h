@@ -35,8 +35,13 @@ class ProgramBuilder {
   /// out[slot] = register reg.
   void store(uint32_t slot, uint32_t reg) { emit(Op::Store, reg, 0, 0, slot); }
 
-  /// Symbols met that have no binding (each lowered as NaN), in order of first use.
-  const std::vector<sym::Expr>& unboundSymbols() const { return unbound_; }
+  /// A symbol met that has no binding (lowered as NaN), and the source whose code first used it.
+  struct UnboundUse {
+    sym::Expr symbol;
+    uint32_t source;
+  };
+  /// Every unbound symbol, in order of first use.
+  const std::vector<UnboundUse>& unboundSymbols() const { return unbound_; }
   Program finish(uint32_t outputCount);
 
  private:
@@ -77,7 +82,7 @@ class ProgramBuilder {
   std::vector<sym::Expr> temporaries_;                // by symbolId
   std::vector<Load> loads_;                           // by symbolId
   std::unordered_map<uint64_t, uint32_t> constants_;  // bit pattern -> register
-  std::vector<sym::Expr> unbound_;
+  std::vector<UnboundUse> unbound_;
   std::vector<Frame> frames_;  // lower()'s stack, kept to reuse its storage
 };
 

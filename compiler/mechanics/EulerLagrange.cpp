@@ -120,7 +120,7 @@ class Deriver {
       if (var < 0) continue;
       VarRole r = m_.variables[var].role;
       if (mayAppearInEnergy(r)) continue;
-      diags_.error(t.range, "E0402",
+      diags_.error(t.range, DiagCode::E0402,
                    "this energy depends on '" + std::string(m_.variables[var].name) +
                        "', which is not a coordinate or its velocity",
                    r == VarRole::Acceleration
@@ -175,7 +175,7 @@ class Deriver {
     }
     Expr residual = ctx_.add(parts);
     if (lagrangian_.termsOf(q).empty() && lagrangian_.termsOf(v).empty() && forces_[q].empty() && !constrained) {
-      diags_.error(coord.declRange, "E0401",
+      diags_.error(coord.declRange, DiagCode::E0401,
                    "coordinate '" + std::string(coord.name) + "' appears in no energy, force or constraint",
                    "add its kinetic energy in the mechanics section, or declare it as a plain 'Real'");
       return;

@@ -19,7 +19,7 @@ const BuiltinFunction kBuiltins[] = {
     {"dot", 2, 2},      {"transpose", 1, 1}, {"diagonal", 1, 1}, {"identity", 1, 1}, {"size", 1, 2},
 };
 
-// Names that parse as calls but belong to features of later issues (events).
+// Names that parse as calls but belong to events, which qdot does not compile.
 bool isEventFunction(std::string_view n) {
   return n == "pre" || n == "reinit" || n == "initial" || n == "edge" || n == "sample" || n == "change";
 }
@@ -38,8 +38,8 @@ class Checker {
   void run() {
     for (const auto& d : m_.cls->declarations) declare(d);
     for (const auto& e : m_.cls->extends)
-      diags_.error(e.range, "E0290", "'extends' is not supported yet",
-                   "components and inheritance arrive with the components issue; inline the base model");
+      diags_.error(e.range, DiagCode::E0290, "'extends' is not supported yet",
+                   "inline the base model: copy its declarations and equations into this model");
     for (const auto* d : m_.declarations) checkDeclaration(*d);
     for (const auto& eq : m_.cls->equations) checkEquation(eq);
     for (const auto& eq : m_.cls->initialEquations) checkEquation(eq);
@@ -54,7 +54,7 @@ class Checker {
   void declare(const Declaration& d) {
     auto [it, inserted] = m_.symbols.try_emplace(d.name);
     if (!inserted) {
-      auto& diag = diags_.error(d.nameRange, "E0201", "'" + d.name + "' is declared twice",
+      auto& diag = diags_.error(d.nameRange, DiagCode::E0201, "'" + d.name + "' is declared twice",
                                 "rename one of the two declarations");
       diag.notes.push_back({it->second.decl->nameRange, "first declared here"});
       return;
@@ -86,33 +86,33 @@ class Checker {
   bool checkType(const Declaration& d) {
     std::string t = typeNameOf(d);
     if (t == "Real" || t == "Integer" || t == "Boolean") return true;
-    diags_.error(d.typeRange, "E0290", "component type '" + t + "' is not supported yet",
-                 "this version compiles flat models: declare Real, Integer or Boolean variables");
+    diags_.error(d.typeRange, DiagCode::E0290, "component type '" + t + "' is not supported yet",
+                 "write the component's equations in this model instead, with Real, Integer or Boolean variables");
     return false;
   }
 
   void checkKindRules(const Declaration& d, const ModelSymbol& s) {
     if (d.isFlow)
-      diags_.error(d.range, "E0290", "'flow' variables are not supported yet",
-                   "connectors arrive with the components issue");
+      diags_.error(d.range, DiagCode::E0290, "'flow' variables are not supported yet",
+                   "declare a plain Real and write the balance equation yourself, e.g. i1 + i2 = 0;");
     if (d.causality == Causality::Input)
-      diags_.error(d.range, "E0290", "'input' variables are not supported yet",
+      diags_.error(d.range, DiagCode::E0290, "'input' variables are not supported yet",
                    "use a parameter, or a definition in terms of time: Real u = sin(time);");
     if (d.isCoordinate && s.type != BaseType::Real)
-      diags_.error(d.typeRange, "E0205", "coordinate '" + d.name + "' must be of type Real",
+      diags_.error(d.typeRange, DiagCode::E0205, "coordinate '" + d.name + "' must be of type Real",
                    "declare it as: coordinate Real " + d.name + ";");
     if (d.isCoordinate && d.binding)
-      diags_.error(d.binding->range, "E0206", "coordinate '" + d.name + "' cannot have a binding equation",
+      diags_.error(d.binding->range, DiagCode::E0206, "coordinate '" + d.name + "' cannot have a binding equation",
                    "give its initial value instead: coordinate Real " + d.name + "(start = ...);");
     if (d.isCoordinate && d.variability != Variability::Continuous)
-      diags_.error(d.range, "E0206", "a coordinate cannot be a parameter or constant",
+      diags_.error(d.range, DiagCode::E0206, "a coordinate cannot be a parameter or constant",
                    "remove 'parameter'/'constant' from the declaration of '" + d.name + "'");
     if ((s.kind == SymbolKind::Constant || s.kind == SymbolKind::IntegerParameter ||
          s.kind == SymbolKind::Parameter) && !d.binding)
-      diags_.error(d.nameRange, "E0207", "parameter '" + d.name + "' has no value",
+      diags_.error(d.nameRange, DiagCode::E0207, "parameter '" + d.name + "' has no value",
                    "give it a default value, e.g. parameter Real " + d.name + " = 1;");
     if (s.kind == SymbolKind::Unknown && s.type != BaseType::Real)
-      diags_.error(d.typeRange, "E0205", "time-varying variable '" + d.name + "' must be of type Real",
+      diags_.error(d.typeRange, DiagCode::E0205, "time-varying variable '" + d.name + "' must be of type Real",
                    "make it a parameter, or declare it Real");
   }
 
@@ -121,7 +121,7 @@ class Checker {
                                    "quantity", "stateSelect"};
     bool known = std::any_of(std::begin(kAttrs), std::end(kAttrs), [&](const char* a) { return mod.name == a; });
     if (!known) {
-      diags_.error(mod.nameRange, "E0208", "'" + mod.name + "' is not an attribute of '" + d.name + "'",
+      diags_.error(mod.nameRange, DiagCode::E0208, "'" + mod.name + "' is not an attribute of '" + d.name + "'",
                    "attributes are start, fixed, min, max, nominal and unit");
       return;
     }
@@ -133,7 +133,7 @@ class Checker {
     checkExpr(e);
     std::string why;
     if (!isIntegerExpr(e, why))
-      diags_.error(e.range, "E0203", "array size must be an Integer expression" + why,
+      diags_.error(e.range, DiagCode::E0203, "array size must be an Integer expression" + why,
                    "sizes are integer literals or 'parameter Integer' values, e.g. parameter Integer n = 3;");
   }
 
@@ -167,15 +167,16 @@ class Checker {
         withIterators(eq.iterators, [&] { for (const auto& b : eq.body) checkEquation(b); });
         return;
       case EquationKind::Connect:
-        diags_.error(eq.range, "E0290", "'connect' is not supported yet",
-                     "connectors arrive with the components issue");
+        diags_.error(eq.range, DiagCode::E0290, "'connect' is not supported yet",
+                     "write the equations the connection stands for: equal potentials (v1 = v2;) and flows "
+                     "that sum to zero (i1 + i2 = 0;)");
         return;
       case EquationKind::When:
-        diags_.error(eq.range, "E0290", "'when' equations are not supported yet",
-                     "events arrive with a later issue");
+        diags_.error(eq.range, DiagCode::E0290, "'when' equations are not supported yet",
+                     "for a switch that depends on the state, write an if-expression: f = if x > 0 then -k*x else 0;");
         return;
       case EquationKind::If:
-        diags_.error(eq.range, "E0290", "'if' equations are not supported yet",
+        diags_.error(eq.range, DiagCode::E0290, "'if' equations are not supported yet",
                      "write the equation with an if-expression: x = if c then a else b;");
         return;
     }
@@ -197,13 +198,13 @@ class Checker {
     if (auto* ix = dyn_cast<IndexExpr>(base)) base = ix->base.get();
     auto* name = dyn_cast<NameExpr>(base);
     if (!name || name->parts.size() != 1) {
-      diags_.error(target.range, "E0209", "force(...) must name a coordinate",
+      diags_.error(target.range, DiagCode::E0209, "force(...) must name a coordinate",
                    "write force(q) = expr; or force(q[i]) = expr; with q a coordinate");
       return;
     }
     auto it = m_.symbols.find(name->parts[0]);
     if (it != m_.symbols.end() && it->second.kind != SymbolKind::Coordinate)
-      diags_.error(target.range, "E0209", "'" + name->parts[0] + "' is not a coordinate",
+      diags_.error(target.range, DiagCode::E0209, "'" + name->parts[0] + "' is not a coordinate",
                    "generalized forces act on coordinates: declare it 'coordinate Real " + name->parts[0] + "'");
   }
 
@@ -218,8 +219,8 @@ class Checker {
   void checkName(const NameExpr& n) {
     const std::string& first = n.parts[0];
     if (n.parts.size() > 1) {
-      diags_.error(n.range, "E0290", "dotted name '" + n.dotted() + "' is not supported yet",
-                   "components arrive with the components issue");
+      diags_.error(n.range, DiagCode::E0290, "dotted name '" + n.dotted() + "' is not supported yet",
+                   "write the component's variables and equations in this model and use their plain names");
       return;
     }
     if (first == "time" || first == "pi") return;
@@ -228,7 +229,7 @@ class Checker {
     std::vector<std::string> candidates(iterators_);
     for (const auto& [k, v] : m_.symbols) candidates.push_back(k);
     std::string guess = closestName(first, candidates);
-    diags_.error(n.partRanges.empty() ? n.range : n.partRanges[0], "E0202", "unknown name '" + first + "'",
+    diags_.error(n.partRanges.empty() ? n.range : n.partRanges[0], DiagCode::E0202, "unknown name '" + first + "'",
                  guess.empty() ? "declare it, e.g. parameter Real " + first + " = 1;"
                                : "did you mean '" + guess + "'?");
   }
@@ -236,11 +237,11 @@ class Checker {
   void checkCall(const CallExpr& c) {
     std::string name = c.callee->dotted();
     for (const auto& na : c.namedArgs)
-      diags_.error(na.nameRange, "E0211", "named arguments are not allowed in a call to '" + name + "'",
+      diags_.error(na.nameRange, DiagCode::E0211, "named arguments are not allowed in a call to '" + name + "'",
                    "pass the arguments by position");
     if (isEventFunction(name)) {
-      diags_.error(c.callee->range, "E0290", "'" + name + "' is not supported yet",
-                   "events (when, pre, reinit) arrive with a later issue");
+      diags_.error(c.callee->range, DiagCode::E0290, "'" + name + "' is not supported yet",
+                   "events are not available: write the behaviour as an if-expression in an equation");
       return;
     }
     const BuiltinFunction* f = findBuiltin(name);
@@ -248,13 +249,13 @@ class Checker {
       std::vector<std::string> names;
       for (const auto& b : kBuiltins) names.push_back(b.name);
       std::string guess = closestName(name, names);
-      diags_.error(c.callee->range, "E0210", "unknown function '" + name + "'",
+      diags_.error(c.callee->range, DiagCode::E0210, "unknown function '" + name + "'",
                    guess.empty() ? "see docs/language.md for the built-in functions"
                                  : "did you mean '" + guess + "'?");
     } else {
       int n = static_cast<int>(c.args.size());
       if (n < f->minArgs || (f->maxArgs >= 0 && n > f->maxArgs))
-        diags_.error(c.range, "E0212",
+        diags_.error(c.range, DiagCode::E0212,
                      "'" + name + "' takes " + arityText(*f) + ", but " + std::to_string(n) + " given");
     }
     for (const auto& a : c.args) checkExpr(*a);
@@ -271,12 +272,12 @@ class Checker {
     switch (e.kind) {
       case ExprKind::Number: case ExprKind::Bool: case ExprKind::End: return;
       case ExprKind::String:
-        diags_.error(e.range, "E0213", "a string is not allowed here", "strings appear only in descriptions and unit attributes");
+        diags_.error(e.range, DiagCode::E0213, "a string is not allowed here", "strings appear only in descriptions and unit attributes");
         return;
       case ExprKind::Name: return checkName(*cast<NameExpr>(&e));
       case ExprKind::Member:
-        diags_.error(e.range, "E0290", "component member access is not supported yet",
-                     "components arrive with the components issue");
+        diags_.error(e.range, DiagCode::E0290, "component member access is not supported yet",
+                     "write the component's variables and equations in this model and use their plain names");
         return;
       case ExprKind::Index: {
         auto* ix = cast<IndexExpr>(&e);

@@ -40,16 +40,16 @@ void DiagnosticEngine::report(Diagnostic d) {
   diags_.push_back(std::move(d));
 }
 
-Diagnostic& DiagnosticEngine::error(SourceRange range, std::string code, std::string message,
+Diagnostic& DiagnosticEngine::error(SourceRange range, DiagCode code, std::string message,
                                     std::string help) {
   if (errors_ >= errorLimit_) return overflow_ = Diagnostic{};
-  report({Severity::Error, std::move(code), range, std::move(message), std::move(help), {}});
+  report({Severity::Error, code, range, std::move(message), std::move(help), {}});
   return diags_.back();
 }
 
-Diagnostic& DiagnosticEngine::warning(SourceRange range, std::string code, std::string message,
+Diagnostic& DiagnosticEngine::warning(SourceRange range, DiagCode code, std::string message,
                                       std::string help) {
-  report({Severity::Warning, std::move(code), range, std::move(message), std::move(help), {}});
+  report({Severity::Warning, code, range, std::move(message), std::move(help), {}});
   return diags_.back();
 }
 
@@ -63,7 +63,7 @@ void DiagnosticEngine::renderOne(std::ostream& os, const SourceManager& sm, cons
     os << bold << sm.name(d.range.file) << ':' << lc.line << ':' << lc.col << ": " << reset;
   }
   os << red << severityName(d.severity);
-  if (!d.code.empty()) os << '[' << d.code << ']';
+  os << '[' << diagCodeName(d.code) << ']';
   os << reset << bold << ": " << d.message << reset << '\n';
   if (d.range.valid()) renderSnippet(os, sm, d.range);
   for (const auto& n : d.notes) {

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "support/DiagnosticCodes.h"
 #include "support/SourceManager.h"
 
 namespace qdot {
@@ -25,7 +26,7 @@ struct DiagnosticNote {
 
 struct Diagnostic {
   Severity severity = Severity::Error;
-  std::string code;     ///< stable code, e.g. "E0101"; see docs/diagnostics.md
+  DiagCode code{};      ///< registered in support/DiagnosticCodes.def; see docs/diagnostics.md
   SourceRange range;    ///< primary location (may be invalid for whole-run errors)
   std::string message;  ///< what is wrong, one sentence, no trailing period
   std::string help;     ///< what to do (empty if nothing useful to say)
@@ -39,8 +40,8 @@ class DiagnosticEngine {
 
   void report(Diagnostic d);
   /// Shorthand for the common case; returns the stored diagnostic so notes can be added.
-  Diagnostic& error(SourceRange range, std::string code, std::string message, std::string help = {});
-  Diagnostic& warning(SourceRange range, std::string code, std::string message, std::string help = {});
+  Diagnostic& error(SourceRange range, DiagCode code, std::string message, std::string help = {});
+  Diagnostic& warning(SourceRange range, DiagCode code, std::string message, std::string help = {});
 
   size_t errorCount() const { return errors_; }
   bool hasErrors() const { return errors_ > 0; }

@@ -76,7 +76,7 @@ Token Lexer::make(TokenKind kind, size_t begin) {
   return tok;
 }
 
-void Lexer::error(SourceRange range, const char* code, std::string message, std::string help) {
+void Lexer::error(SourceRange range, DiagCode code, std::string message, std::string help) {
   diags_.error(range, code, std::move(message), std::move(help));
   pendingError_ = true;
 }
@@ -121,7 +121,7 @@ bool Lexer::skipComment() {
   size_t close = text_.find("*/", pos_ + 2);
   if (close == std::string_view::npos) {
     pos_ = begin + 2;
-    error(rangeFrom(begin), "E0101", "unterminated block comment",
+    error(rangeFrom(begin), DiagCode::E0101, "unterminated block comment",
           "close the comment with '*/' (block comments do not nest)");
     pos_ = text_.size();
     return false;
@@ -142,7 +142,7 @@ void Lexer::skipBadRun() {
   std::string help = ascii ? std::string(one ? "remove it" : "remove them") +
                                  "; operators are + - * / ^ = == <> < <= > >= and names use letters, digits and '_'"
                            : "non-ASCII and control characters may appear only inside strings and comments";
-  error(rangeFrom(begin), "E0102", what + " '" + showBytes(run) + "'", help);
+  error(rangeFrom(begin), DiagCode::E0102, what + " '" + showBytes(run) + "'", help);
 }
 
 /// identifier := [A-Za-z_] [A-Za-z0-9_]*   (keywords are looked up in TokenKinds.def)
@@ -174,15 +174,15 @@ Token Lexer::lexNumber() {
   double value = 0;
   auto res = std::from_chars(text.data(), text.data() + text.size(), value);
   if (malformed) {
-    error(rangeFrom(begin), "E0104", "malformed number '" + std::string(text) + "'",
+    error(rangeFrom(begin), DiagCode::E0104, "malformed number '" + std::string(text) + "'",
           "an exponent needs digits, as in 1e-3 or 2.5E+4");
   } else if (res.ptr != text.data() + text.size()) {
-    error(rangeFrom(begin), "E0104", "malformed number '" + std::string(text) + "'",
+    error(rangeFrom(begin), DiagCode::E0104, "malformed number '" + std::string(text) + "'",
           "numbers look like 1, 1.5, 1e-3 or 2.5E+4");
   } else if (res.ec == std::errc::result_out_of_range) {
     value = std::strtod(std::string(text).c_str(), nullptr);
     if (std::isinf(value))
-      error(rangeFrom(begin), "E0106", "number '" + std::string(text) + "' is too large", "");
+      error(rangeFrom(begin), DiagCode::E0106, "number '" + std::string(text) + "' is too large", "");
   }
   Token tok = make(TokenKind::number, begin);
   tok.number = value;
@@ -201,7 +201,7 @@ Token Lexer::lexString() {
     size_t nl = text_.find('\n', begin);
     size_t stop = nl == std::string_view::npos ? text_.size() : nl;
     pos_ = begin + 1;
-    error(rangeFrom(begin), "E0103", "unterminated string", "add the closing '\"'");
+    error(rangeFrom(begin), DiagCode::E0103, "unterminated string", "add the closing '\"'");
     value.assign(text_.substr(begin + 1, stop - begin - 1));
     pos_ = stop;
     Token tok = make(TokenKind::string, begin);
@@ -239,7 +239,7 @@ bool Lexer::lexEscape(std::string& out) {
     default: break;
   }
   if (c == '\n' || static_cast<unsigned char>(c) >= 0x80 || static_cast<unsigned char>(c) < 0x20) --pos_;
-  error(rangeFrom(begin), "E0105", "unknown escape sequence '" + showBytes(text_.substr(begin, pos_ - begin)) + "'",
+  error(rangeFrom(begin), DiagCode::E0105, "unknown escape sequence '" + showBytes(text_.substr(begin, pos_ - begin)) + "'",
         "known escapes are \\\" \\' \\? \\\\ \\a \\b \\f \\n \\r \\t \\v; write \\\\ for a backslash");
   out.append(text_.substr(begin + 1, pos_ - begin - 1));
   return false;

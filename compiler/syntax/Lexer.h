@@ -36,7 +36,7 @@ class Lexer {
   bool lexEscape(std::string& out);
   Token lexPunct();
 
-  void error(SourceRange range, const char* code, std::string message, std::string help = {});
+  void error(SourceRange range, DiagCode code, std::string message, std::string help = {});
 
   uint32_t file_;
   std::string_view text_;

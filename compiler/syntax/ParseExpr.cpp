@@ -66,7 +66,7 @@ ExprPtr Parser::parseIfExpression() {
     if (panic_) return nullptr;
   } while (accept(TokenKind::kw_elseif));
   if (!at(TokenKind::kw_else)) {
-    failExpected("'else' in the if-expression", "E0117", "an if-expression needs an 'else' branch: if c then a else b");
+    failExpected("'else' in the if-expression", DiagCode::E0117, "an if-expression needs an 'else' branch: if c then a else b");
     return nullptr;
   }
   take();
@@ -87,7 +87,7 @@ ExprPtr Parser::parseRange() {
     return std::make_unique<ast::RangeExpr>(rangeFrom(begin), std::move(first), nullptr, std::move(second));
   ExprPtr third = parseOr();
   if (!panic_ && at(TokenKind::colon))
-    fail(tok().range, "E0115", "a range has at most three parts", "write start:stop or start:step:stop");
+    fail(tok().range, DiagCode::E0115, "a range has at most three parts", "write start:stop or start:step:stop");
   return std::make_unique<ast::RangeExpr>(rangeFrom(begin), std::move(first), std::move(second), std::move(third));
 }
 
@@ -139,7 +139,7 @@ ExprPtr Parser::parseRelation() {
   ChainGuard chain(*this);
   while (!panic_ && relationalOp(tok().kind) && chain.next()) {
     if (chained)
-      report(tok().range, "E0115", "comparison operators cannot be chained",
+      report(tok().range, DiagCode::E0115, "comparison operators cannot be chained",
              "combine the comparisons with 'and': a < b and b < c");
     OpTok op = takeOp();
     ExprPtr rhs = parseArithmetic();
@@ -231,7 +231,7 @@ ExprPtr Parser::parseFactor() {
   std::string help = "add parentheses: (";  // (a^b)^c or a^(b^c); append() avoids a GCC 12 -Wrestrict false alarm
   help.append(a).append("^").append(b).append(")^").append(c).append(" or ");
   help.append(a).append("^(").append(b).append("^").append(c);
-  report(at, "E0114", "the power operator '^' is not associative", help + ")");
+  report(at, DiagCode::E0114, "the power operator '^' is not associative", help + ")");
 }
 
 /// power_operand := ["+" | "-"] postfix                  (a^-1)
@@ -262,7 +262,7 @@ ExprPtr Parser::parsePostfix() {
       }
       take();
       if (!at(TokenKind::identifier)) {
-        failExpected("a name after '.'", "E0116");
+        failExpected("a name after '.'", DiagCode::E0116);
         break;
       }
       std::string_view field = tok().text;
@@ -291,12 +291,12 @@ ExprPtr Parser::parsePostfix() {
 }
 
 [[gnu::noinline]] void Parser::failNotComponent(const ast::Expr& e) {
-  fail(tok().range, "E0118", "only a component can have members, not " + quote(sm_.slice(e.range)),
+  fail(tok().range, DiagCode::E0118, "only a component can have members, not " + quote(sm_.slice(e.range)),
        "member access looks like a.b or ms[2].a");
 }
 
 [[gnu::noinline]] void Parser::failNotCallable(const ast::Expr& e) {
-  fail(tok().range, "E0118", "only a name can be called, not " + quote(sm_.slice(e.range)),
+  fail(tok().range, DiagCode::E0118, "only a name can be called, not " + quote(sm_.slice(e.range)),
        "call functions by name, as in f(x) or Package.f(x)");
 }
 
@@ -339,7 +339,7 @@ ExprPtr Parser::unexpectedInExpression() {
   std::string help;
   if (at(TokenKind::kw_if)) help = "an if-expression inside a larger expression needs parentheses: (if c then a else b)";
   if (at(TokenKind::lBracket)) help = "array literals are written with braces: {1, 2, 3}";
-  failExpected("an expression", "E0111", help);
+  failExpected("an expression", DiagCode::E0111, help);
   return nullptr;
 }
 
@@ -354,7 +354,7 @@ ExprPtr Parser::parseKeywordCall() {
 }
 
 [[gnu::noinline]] ExprPtr Parser::failKeywordCall(std::string_view keyword) {
-  failExpected("'(' after " + quote(keyword), "E0117",
+  failExpected("'(' after " + quote(keyword), DiagCode::E0117,
                quote(keyword) + " is called like a function: " + std::string(keyword) + "(...)");
   return nullptr;
 }
@@ -383,7 +383,7 @@ ExprPtr Parser::parseArrayConstructor() {
   elements.push_back(std::move(first));
   while (!panic_ && accept(TokenKind::comma)) elements.push_back(parseExpression());
   if (!panic_ && at(TokenKind::kw_for))
-    fail(tok().range, "E0118", "an array comprehension has a single body expression",
+    fail(tok().range, DiagCode::E0118, "an array comprehension has a single body expression",
          "write {e for i in 1:n}, or list the elements: {a, b, c}");
   if (!panic_) expectClose(TokenKind::rBrace, open, true);
   return std::make_unique<ast::ArrayExpr>(rangeFrom(begin), std::move(elements));
@@ -448,7 +448,7 @@ bool Parser::parseCallArgument(ast::CallExpr& call, bool& sawNamed) {
     return !panic_;
   }
   if (sawNamed)
-    report(tok().range, "E0118", "positional argument after a named argument", "put the positional arguments first");
+    report(tok().range, DiagCode::E0118, "positional argument after a named argument", "put the positional arguments first");
   uint32_t begin = tok().range.begin;
   ExprPtr e = parseExpression();
   if (panic_) return false;
@@ -459,7 +459,7 @@ bool Parser::parseCallArgument(ast::CallExpr& call, bool& sawNamed) {
   bool alone = call.args.empty() && call.namedArgs.empty();
   if (alone) call.args.push_back(parseComprehension(std::move(e), begin));
   if (!panic_ && (!alone || at(TokenKind::comma)))
-    fail(tok().range, "E0118", "a reduction 'e for i in r' must be the only argument",
+    fail(tok().range, DiagCode::E0118, "a reduction 'e for i in r' must be the only argument",
          "write e.g. sum(x[i] for i in 1:n)");
   return false;
 }

@@ -50,7 +50,7 @@ std::optional<ast::Equation> Parser::parseEquation() {
   if (at(TokenKind::kw_constraint)) help = "'constraint' statements belong in the 'mechanics' section";
   if (at(TokenKind::kw_else) || at(TokenKind::kw_elseif)) help = "there is no open 'if' for this";
   if (at(TokenKind::kw_elsewhen)) help = "there is no open 'when' for this";
-  failExpected("an equation", "E0123", help);
+  failExpected("an equation", DiagCode::E0123, help);
   return std::nullopt;
 }
 
@@ -67,7 +67,7 @@ std::optional<ast::Equation> Parser::parseSimpleEquation() {
     if (panic_) return std::nullopt;
   } else if (!ast::isa<ast::CallExpr>(eq.lhs.get())) {
     auto* bin = ast::dyn_cast<ast::BinaryExpr>(eq.lhs.get());
-    failExpected("'=' in the equation", "E0117",
+    failExpected("'=' in the equation", DiagCode::E0117,
                  bin && bin->op == ast::BinaryOp::Eq ? "'==' compares two values; an equation is written 'lhs = rhs;'"
                                                      : "an equation is written 'lhs = rhs;'");
     return std::nullopt;
@@ -140,7 +140,7 @@ ast::Equation Parser::parseConnect() {
   eq.kind = ast::EquationKind::Connect;
   eq.range = kw.range;
   if (!at(TokenKind::lParen)) {
-    failExpected("'(' after 'connect'", "E0117", "write connect(a, b);");
+    failExpected("'(' after 'connect'", DiagCode::E0117, "write connect(a, b);");
     return eq;
   }
   OpTok open = takeOp();
@@ -196,7 +196,7 @@ std::optional<ast::MechanicsStmt> Parser::parseMechanicsStmt() {
     parseAnnotationStatement();
     return std::nullopt;
   }
-  failExpected("a mechanics statement", "E0124",
+  failExpected("a mechanics statement", DiagCode::E0124,
                "the mechanics section holds 'kinetic = e;', 'potential = e;', 'dissipation = e;', "
                "'force(q) = e;', 'constraint lhs = rhs;' and for-loops; equations go in an 'equation' section");
   return std::nullopt;
@@ -222,7 +222,7 @@ ast::MechanicsStmt Parser::parseForceStmt() {
   s.kind = ast::MechanicsKind::Force;
   s.keywordRange = kw.range;
   if (!at(TokenKind::lParen)) {
-    failExpected("'(' after 'force'", "E0117", "write force(q) = e; with the coordinate q in parentheses");
+    failExpected("'(' after 'force'", DiagCode::E0117, "write force(q) = e; with the coordinate q in parentheses");
   } else {
     OpTok open = takeOp();
     s.target = parseExpression();
@@ -277,12 +277,12 @@ std::vector<ast::Iterator> Parser::parseForIndices() {
   std::vector<ast::Iterator> its;
   do {
     if (!at(TokenKind::identifier)) {
-      failExpected("a loop variable", "E0116", "write 'for i in 1:n'");
+      failExpected("a loop variable", DiagCode::E0116, "write 'for i in 1:n'");
       break;
     }
     Token name = take();
     if (!at(TokenKind::kw_in)) {
-      failExpected("'in' after the loop variable '" + std::string(name.text) + "'", "E0117", "write 'for i in 1:n'");
+      failExpected("'in' after the loop variable '" + std::string(name.text) + "'", DiagCode::E0117, "write 'for i in 1:n'");
       break;
     }
     take();

@@ -151,7 +151,7 @@ bool Parser::skipUnsupported() {
   const char* help = word == "partial" ? "remove 'partial'"
                      : word == "algorithm" ? "write the relations as equations in an 'equation' section"
                                            : "remove it; all declarations are public and come before the first section";
-  report(tok().range, "E0119", quote(word) + (word == "partial" ? " classes are" : " sections are") + " not supported",
+  report(tok().range, DiagCode::E0119, quote(word) + (word == "partial" ? " classes are" : " sections are") + " not supported",
          help);
   take();
   if (word != "algorithm") return true;
@@ -187,7 +187,7 @@ bool Parser::atSyncPoint() {
 // Diagnostics and recovery
 // ---------------------------------------------------------------------------------------------
 
-Diagnostic* Parser::report(SourceRange r, const char* code, std::string msg, std::string help) {
+Diagnostic* Parser::report(SourceRange r, DiagCode code, std::string msg, std::string help) {
   if (panic_ || diags_.limitReached()) return nullptr;
   // An error right after a lexical error is most likely its consequence.
   if (tok().afterLexError && r.begin >= prev_.range.end) return nullptr;
@@ -196,19 +196,19 @@ Diagnostic* Parser::report(SourceRange r, const char* code, std::string msg, std
   return &diags_.error(r, code, std::move(msg), std::move(help));
 }
 
-Diagnostic* Parser::fail(SourceRange r, const char* code, std::string msg, std::string help) {
+Diagnostic* Parser::fail(SourceRange r, DiagCode code, std::string msg, std::string help) {
   Diagnostic* d = report(r, code, std::move(msg), std::move(help));
   panic_ = true;
   return d;
 }
 
-void Parser::failExpected(const std::string& what, const char* code, std::string help) {
+void Parser::failExpected(const std::string& what, DiagCode code, std::string help) {
   fail(tok().range, code, "expected " + what + ", found " + describe(tok()), std::move(help));
 }
 
 bool Parser::expect(TokenKind k, const std::string& context) {
   if (accept(k)) return true;
-  failExpected(quoted(k) + (context.empty() ? "" : " " + context), "E0117");
+  failExpected(quoted(k) + (context.empty() ? "" : " " + context), DiagCode::E0117);
   return false;
 }
 
@@ -219,16 +219,16 @@ bool Parser::expectSemi(const std::string& context) {
   std::string msg = "expected ';' " + context + ", found " + describe(tok());
   bool newLine = at(TokenKind::eof) || lineOf(tok().range.begin) > lineOf(prev_.range.end);
   if (newLine || atSyncPoint())
-    report(afterPrev(), "E0112", msg, "add ';' here");
+    report(afterPrev(), DiagCode::E0112, msg, "add ';' here");
   else
-    fail(afterPrev(), "E0112", msg, "add ';' here");
+    fail(afterPrev(), DiagCode::E0112, msg, "add ';' here");
   return false;
 }
 
 bool Parser::expectClose(TokenKind close, OpTok open, bool inList) {
   if (accept(close)) return true;
   std::string what = inList ? "',' or " + quoted(close) : quoted(close);
-  Diagnostic* d = fail(tok().range, "E0113", "expected " + what + ", found " + describe(tok()),
+  Diagnostic* d = fail(tok().range, DiagCode::E0113, "expected " + what + ", found " + describe(tok()),
                        "add " + quoted(close) + " to close the " + quoted(open.kind));
   if (d) d->notes.push_back({open.range, "this " + quoted(open.kind) + " is not closed"});
   return false;
@@ -243,7 +243,7 @@ bool Parser::expectEnd(TokenKind kw, SourceRange open) {
   }
   brokenBlocks_.push_back(kw);
   std::string closer = std::string("'end ") + spelling(kw) + "'";
-  Diagnostic* d = fail(tok().range, "E0117", "expected " + closer + ", found " + describe(tok()),
+  Diagnostic* d = fail(tok().range, DiagCode::E0117, "expected " + closer + ", found " + describe(tok()),
                        std::string("close the block with 'end ") + spelling(kw) + ";'");
   if (d) d->notes.push_back({open, "the " + quoted(kw) + " block starts here"});
   return false;
@@ -293,7 +293,7 @@ bool Parser::skipStrayEnd() {
   if (broken != brokenBlocks_.rend())
     brokenBlocks_.erase(std::next(broken).base());
   else if (!quietStrayEnds_)
-    report(tok().range, "E0123", std::string("'end ") + spelling(k) + "' without a matching " + quoted(k),
+    report(tok().range, DiagCode::E0123, std::string("'end ") + spelling(k) + "' without a matching " + quoted(k),
            "remove it, or open the block before it");
   take();
   take();
@@ -304,7 +304,7 @@ bool Parser::skipStrayEnd() {
 void Parser::tooDeep(const char* what) {
   quietStrayEnds_ = true;
   if (!std::exchange(reportedTooDeep_, true))
-    fail(tok().range, "E0110", std::string(what) + " nested too deeply",
+    fail(tok().range, DiagCode::E0110, std::string(what) + " nested too deeply",
          "at most " + std::to_string(kMaxNestingDepth) +
              " levels of nesting are allowed (a long chain such as a + b + c counts one level per operator); "
              "split it up with intermediate variables");
@@ -331,14 +331,14 @@ std::unique_ptr<ast::StoredDefinition> Parser::parseStoredDefinition() {
     } else if (skipUnsupported()) {
       continue;
     } else {
-      if (!panic_) failExpected("'model', 'connector' or 'package'", "E0120", "a .qd file contains classes: model M ... end M;");
+      if (!panic_) failExpected("'model', 'connector' or 'package'", DiagCode::E0120, "a .qd file contains classes: model M ... end M;");
       reported = true;
       while (!at(TokenKind::eof) && !atClassKeyword() && !at(TokenKind::kw_within)) take();
     }
     if (consumed_ == start) take();
   }
   if (def->classes.empty() && !reported)
-    report(tok().range, "E0120", "expected 'model', 'connector' or 'package', found end of file",
+    report(tok().range, DiagCode::E0120, "expected 'model', 'connector' or 'package', found end of file",
            "a .qd file contains at least one class: model M ... end M;");
   return def;
 }
@@ -350,7 +350,7 @@ void Parser::parseWithin(ast::StoredDefinition& def) {
   std::vector<std::string> parts;
   if (at(TokenKind::identifier)) parseDottedName(parts, nullptr);
   if (misplaced)
-    report(kw.range, "E0127", "'within' must come first in the file", "move the 'within' clause to the top");
+    report(kw.range, DiagCode::E0127, "'within' must come first in the file", "move the 'within' clause to the top");
   else
     def.within = std::move(parts);
   expectSemi("after the 'within' clause");
@@ -371,7 +371,7 @@ std::unique_ptr<ast::ClassDef> Parser::parseClass() {
     return cls;
   }
   if (!at(TokenKind::identifier)) {
-    failExpected("a class name after " + quoted(kw.kind), "E0116");
+    failExpected("a class name after " + quoted(kw.kind), DiagCode::E0116);
     return cls;
   }
   Token name = take();
@@ -399,7 +399,7 @@ void Parser::parseShortClass(ast::ClassDef& cls) {
   ast::ExtendsClause ext;
   uint32_t begin = tok().range.begin;
   if (!parseTypeSpecifier(ext.baseName, ext.range)) {
-    failExpected("a type name after '='", "E0116", "write e.g. 'type Length = Real(unit = \"m\");'");
+    failExpected("a type name after '='", DiagCode::E0116, "write e.g. 'type Length = Real(unit = \"m\");'");
     return;
   }
   if (at(TokenKind::lParen)) ext.mods = parseClassModification();
@@ -422,7 +422,7 @@ void Parser::parseComposition(ast::ClassDef& cls) {
       parseSection(cls);
     } else {
       if (firstSection.valid() && !at(TokenKind::kw_annotation)) {
-        Diagnostic* d = report(tok().range, "E0125", "declarations must come before the first section",
+        Diagnostic* d = report(tok().range, DiagCode::E0125, "declarations must come before the first section",
                                "move this above the '" + std::string(sm_.slice(firstSection)) + "' line");
         if (d) d->notes.push_back({firstSection, "the first section starts here"});
       }
@@ -436,7 +436,7 @@ void Parser::parseComposition(ast::ClassDef& cls) {
 void Parser::parseClassEnd(ast::ClassDef& cls) {
   std::string closer = "'end " + cls.name + ";'";
   if (at(TokenKind::eof)) {
-    Diagnostic* d = report(afterPrev(), "E0126", "expected " + closer + " before the end of the file", "add " + closer);
+    Diagnostic* d = report(afterPrev(), DiagCode::E0126, "expected " + closer + " before the end of the file", "add " + closer);
     if (d) d->notes.push_back({cls.nameRange, "'" + cls.name + "' starts here"});
     return;
   }
@@ -445,7 +445,7 @@ void Parser::parseClassEnd(ast::ClassDef& cls) {
                      std::any_of(openClasses_.begin(), openClasses_.end() - 1,
                                  [&](const ast::ClassDef* c) { return c->name == next.text; });
   if (closesOuter) {  // the inner class lacks its end: leave `end Outer` to the outer class
-    Diagnostic* d = report(tok().range, "E0126", "expected " + closer + " before 'end " + std::string(next.text) + "'",
+    Diagnostic* d = report(tok().range, DiagCode::E0126, "expected " + closer + " before 'end " + std::string(next.text) + "'",
                            "add " + closer);
     if (d) d->notes.push_back({cls.nameRange, "'" + cls.name + "' starts here"});
     return;
@@ -454,13 +454,13 @@ void Parser::parseClassEnd(ast::ClassDef& cls) {
   if (at(TokenKind::identifier)) {
     Token name = take();
     if (name.text != cls.name) {
-      Diagnostic* d = report(name.range, "E0121",
+      Diagnostic* d = report(name.range, DiagCode::E0121,
                              "'end " + std::string(name.text) + "' does not match the class name '" + cls.name + "'",
                              "write " + closer);
       if (d) d->notes.push_back({cls.nameRange, "the class is named here"});
     }
   } else {
-    report(tok().range, "E0121", "expected the class name '" + cls.name + "' after 'end', found " + describe(tok()),
+    report(tok().range, DiagCode::E0121, "expected the class name '" + cls.name + "' after 'end', found " + describe(tok()),
            "write " + closer);
     if (at(TokenKind::kw_for) || at(TokenKind::kw_if) || at(TokenKind::kw_when)) take();
   }
@@ -486,7 +486,7 @@ void Parser::parseElement(ast::ClassDef& cls) {
       help = "mechanics statements go after the 'mechanics' keyword";
     else if (at(TokenKind::identifier) || canStartExpression())
       help = "equations go after the 'equation' keyword";
-    failExpected("a declaration", "E0123", help);
+    failExpected("a declaration", DiagCode::E0123, help);
   }
 }
 
@@ -496,7 +496,7 @@ void Parser::parseExtends(ast::ClassDef& cls) {
   ast::ExtendsClause ext;
   SourceRange typeRange;
   if (!parseTypeSpecifier(ext.baseName, typeRange)) {
-    failExpected("a class name after 'extends'", "E0116");
+    failExpected("a class name after 'extends'", DiagCode::E0116);
     return;
   }
   if (at(TokenKind::lParen)) ext.mods = parseClassModification();
@@ -515,7 +515,7 @@ void Parser::parseImport(ast::ClassDef& cls) {
     take();
   }
   if (!at(TokenKind::identifier)) {
-    failExpected("a package name after " + std::string(imp.alias.empty() ? "'import'" : "'='"), "E0116");
+    failExpected("a package name after " + std::string(imp.alias.empty() ? "'import'" : "'='"), DiagCode::E0116);
     return;
   }
   imp.path.emplace_back(take().text);
@@ -525,7 +525,7 @@ void Parser::parseImport(ast::ClassDef& cls) {
       imp.wildcard = true;
       break;
     }
-    if (!at(TokenKind::identifier)) return failExpected("a name or '*' after '.'", "E0116");
+    if (!at(TokenKind::identifier)) return failExpected("a name or '*' after '.'", DiagCode::E0116);
     imp.path.emplace_back(take().text);
   }
   parseDescription();
@@ -545,13 +545,13 @@ void Parser::parseComponentClause(ast::ClassDef& cls) {
   std::vector<std::string> type;
   SourceRange typeRange;
   if (!parseTypeSpecifier(type, typeRange)) {
-    failExpected(pre.begin == UINT32_MAX ? "a type name" : "a type name after the prefixes", "E0116",
+    failExpected(pre.begin == UINT32_MAX ? "a type name" : "a type name after the prefixes", DiagCode::E0116,
                  "declarations look like 'parameter Real k = 1;'");
     return;
   }
   if (pre.begin != UINT32_MAX && type.size() == 1 && !at(TokenKind::identifier) && !at(TokenKind::lBracket) &&
       prev_.is(TokenKind::identifier)) {  // `parameter k = 1;`
-    fail(typeRange, "E0116", "missing type in the declaration of '" + type[0] + "'",
+    fail(typeRange, DiagCode::E0116, "missing type in the declaration of '" + type[0] + "'",
          "write the type before the name, as in 'parameter Real " + type[0] + " = 1;'");
     return;
   }
@@ -598,9 +598,9 @@ Parser::Prefixes Parser::parsePrefixes() {
       duplicate = flag;
       flag = true;
     }
-    if (duplicate) report(t.range, "E0122", "duplicate prefix " + name, "remove the repeated " + name);
+    if (duplicate) report(t.range, DiagCode::E0122, "duplicate prefix " + name, "remove the repeated " + name);
     if (!conflict.empty())
-      report(t.range, "E0122", name + " conflicts with an earlier prefix", "a declaration is either '" + conflict + "'");
+      report(t.range, DiagCode::E0122, name + " conflicts with an earlier prefix", "a declaration is either '" + conflict + "'");
   }
   return p;
 }
@@ -632,7 +632,7 @@ bool Parser::parseDottedName(std::vector<std::string>& parts, std::vector<Source
 ///               [description] [annotation]
 bool Parser::parseDeclarator(ast::Declaration& d) {
   if (!at(TokenKind::identifier)) {
-    failExpected("a name after the type '" + join(d.typeName) + "'", "E0116");
+    failExpected("a name after the type '" + join(d.typeName) + "'", DiagCode::E0116);
     return false;
   }
   Token name = take();
@@ -673,7 +673,7 @@ std::optional<ast::Modification> Parser::parseArgument() {
   std::vector<std::string> parts;
   std::vector<SourceRange> ranges;
   if (!parseDottedName(parts, &ranges)) {
-    failExpected("a name in the modification", "E0116", "modifications look like (start = 0, fixed = true)");
+    failExpected("a name in the modification", DiagCode::E0116, "modifications look like (start = 0, fixed = true)");
     return std::nullopt;
   }
   ast::Modification m;
@@ -691,7 +691,7 @@ ast::Annotation Parser::parseAnnotation() {
   Token kw = take();
   ast::Annotation a;
   if (!at(TokenKind::lParen))
-    failExpected("'(' after 'annotation'", "E0117", "write annotation(experiment(StopTime = 10))");
+    failExpected("'(' after 'annotation'", DiagCode::E0117, "write annotation(experiment(StopTime = 10))");
   else
     a.mods = parseClassModification();
   a.range = rangeFrom(kw.range.begin);

@@ -105,9 +105,9 @@ class Parser {
   uint32_t lineOf(uint32_t offset) const { return sm_.lineCol(file_, offset).line; }
 
   // --- diagnostics and recovery (Parser.cpp) -------------------------------------------------
-  Diagnostic* report(SourceRange r, const char* code, std::string msg, std::string help = {});
-  Diagnostic* fail(SourceRange r, const char* code, std::string msg, std::string help = {});
-  void failExpected(const std::string& what, const char* code, std::string help = {});
+  Diagnostic* report(SourceRange r, DiagCode code, std::string msg, std::string help = {});
+  Diagnostic* fail(SourceRange r, DiagCode code, std::string msg, std::string help = {});
+  void failExpected(const std::string& what, DiagCode code, std::string help = {});
   bool expect(TokenKind k, const std::string& context);
   bool expectSemi(const std::string& context);
   bool expectClose(TokenKind close, OpTok open, bool inList = false);

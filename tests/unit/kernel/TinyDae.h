@@ -8,12 +8,14 @@
 #include <limits>
 
 #include "kernel/Kernel.h"
+#include "support/Diagnostic.h"
 
 namespace qdot::test {
 
 struct TinyDae {
   sym::Context ctx;
   dae::Dae dae;
+  DiagnosticEngine diags;  ///< what buildKernels reports
   sym::Expr t = ctx.symbol("time"), x = ctx.symbol("x"), v = ctx.symbol("der(x)"), dx = ctx.symbol("$der(x)"),
             a = ctx.symbol("der(der(x))"), k = ctx.symbol("k"), m = ctx.symbol("m");
 

@@ -1,11 +1,13 @@
-// Runs every model in tests/diagnostics/ through the whole front end and compares the reported
-// diagnostics with the file's own expectations, written as comments:
+// Runs every model in tests/diagnostics/ through the front end and the kernel stage and compares
+// the reported diagnostics with the file's own expectations, written as comments:
 //   // expect: LINE:COL: error[CODE]: exact message
+//   // help: exact help line (optional; each must be among the rendered help lines)
 // Every expected diagnostic must be reported and nothing else (exact location, code and message).
 #include <algorithm>
 #include <filesystem>
 
 #include "CompiledModel.h"
+#include "kernel/Kernel.h"
 
 namespace qdot::test {
 namespace {
@@ -21,11 +23,10 @@ std::vector<std::string> corpusFiles() {
   return files;
 }
 
-std::vector<std::string> expectations(const std::string& text) {
+std::vector<std::string> expectations(const std::string& text, const std::string& marker = "// expect: ") {
   std::vector<std::string> out;
   std::istringstream in(text);
   std::string line;
-  const std::string marker = "// expect: ";
   while (std::getline(in, line))
     if (auto p = line.find(marker); p != std::string::npos) out.push_back(line.substr(p + marker.size()));
   return out;
@@ -51,8 +52,8 @@ TEST_P(DiagnosticsCorpus, ReportsExactlyTheExpectedDiagnostics) {
   std::vector<std::string> expected = expectations(text);
   ASSERT_FALSE(expected.empty()) << "a corpus file must state what it expects";
   driver::Compilation c;
-  bool ok = driver::compileSource(c, GetParam(), text, "", driver::Stage::Dae);
-  EXPECT_FALSE(ok);
+  driver::compileSource(c, GetParam(), text, "", driver::Stage::Kernel);  // every check short of solving
+  EXPECT_TRUE(c.diags.hasErrors());
   std::vector<std::string> got = reported(c);
   std::ostringstream all;
   c.diags.render(all, c.sources);
@@ -60,11 +61,23 @@ TEST_P(DiagnosticsCorpus, ReportsExactlyTheExpectedDiagnostics) {
     EXPECT_NE(std::find(got.begin(), got.end(), e), got.end()) << "missing: " << e << "\nreported:\n" << all.str();
   for (const auto& g : got)
     EXPECT_NE(std::find(expected.begin(), expected.end(), g), expected.end()) << "unexpected: " << g;
+  for (const auto& h : expectations(text, "// help: "))
+    EXPECT_NE(all.str().find("\nhelp: " + h + "\n"), std::string::npos) << "missing help: " << h << "\n" << all.str();
   // Every error names its location and shows the line with a caret.
   for (const auto& d : c.diags.diagnostics())
     if (d.range.valid()) {
       EXPECT_NE(all.str().find('^'), std::string::npos);
     }
+}
+
+// E0001 is about reading the file itself, so no corpus text can produce it.
+TEST(DiagnosticsOfTheFile, AMissingFileIsReported) {
+  driver::Compilation c;
+  std::string path = std::string(QDOT_SOURCE_DIR) + "/tests/diagnostics/missing.qd";
+  EXPECT_FALSE(driver::compileFile(c, path, "", driver::Stage::Dae));
+  std::ostringstream rendered;
+  c.diags.render(rendered, c.sources);
+  EXPECT_EQ(rendered.str(), "error[E0001]: cannot open file '" + path + "'\nhelp: check the path of the model file\n");
 }
 
 INSTANTIATE_TEST_SUITE_P(Corpus, DiagnosticsCorpus, ::testing::ValuesIn(corpusFiles()),
