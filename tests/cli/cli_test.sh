@@ -56,6 +56,13 @@ for f in /tmp/qdot_cli_chain.$$.qd /tmp/qdot_cli_pchain.$$.qd; do
   contains "chain-run" "0,1,0,100001" "$qdot" run "$f" --stop 0.1
 done
 rm -f /tmp/qdot_cli_chain.$$.qd /tmp/qdot_cli_pchain.$$.qd
+# A binary file given by mistake (here qdot itself): one short error, not a screenful per byte run.
+head -c 300000 "$qdot" >/tmp/qdot_cli_binary.$$.qd
+check binary-file 1 "$qdot" check /tmp/qdot_cli_binary.$$.qd
+bytes=$("$qdot" check /tmp/qdot_cli_binary.$$.qd 2>&1 | wc -c)
+if [ "$bytes" -lt 2000 ]; then pass=$((pass + 1)); else echo "FAIL binary-file-short: $bytes bytes of diagnostics"; fail=$((fail + 1)); fi
+contains binary-file-says "this is not a text file" "$qdot" check /tmp/qdot_cli_binary.$$.qd
+rm -f /tmp/qdot_cli_binary.$$.qd
 for f in "$src"/examples/*/*.qd; do
   check "json-$(basename "$f")" 0 sh -c "'$qdot' equations '$f' --json | python3 -m json.tool"
 done
