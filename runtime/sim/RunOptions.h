@@ -46,6 +46,11 @@ void addRunOptions(CLI::App& app, RunOptions& options);
 /// The whole of text as a finite number (std::from_chars, no trailing characters), or nullopt.
 std::optional<double> parseNumber(std::string_view text);
 
+/// Why parseNumber rejects text, as the end of a sentence about it: "is not a number: 'x'", or
+/// "is out of range: …" for a number too large (1e400) or too close to zero (1e-400) for a double.
+/// (An underflow is refused rather than taken as 0: a value the user wrote is never changed silently.)
+std::string numberRejection(std::string_view text);
+
 /// The given/overridden arrays of QdotModel::parameters.
 struct ParameterOverrides {
   std::vector<double> given;        ///< [nParameters]; 0 where not overridden
@@ -53,7 +58,8 @@ struct ParameterOverrides {
 };
 
 /// Parses the -p NAME=VALUE list against the model's parameter names. Throws UsageError for a
-/// missing '=', an unknown name (suggesting the closest), a value that is not a finite number,
+/// missing '=', an unknown name (suggesting the closest), a value that is not a finite number (or
+/// out of a double's range),
 /// or a parameter given twice.
 ParameterOverrides parameterOverrides(const QdotModel& model, const std::vector<std::string>& assignments);
 
