@@ -31,6 +31,10 @@ void addRunOptions(CLI::App& app, RunOptions& o) {
   app.add_flag("--invariants", o.invariants, "add the model's invariants (energy, momenta) as columns");
   app.add_option("--linear-solver", o.linearSolver, "dense, klu or auto (default auto)")
       ->check(CLI::IsMember({"auto", "dense", "klu"}));
+  app.add_option("--csv-names", o.csvNames,
+                 "CSV header: modelica (der(x), x[1]; default) or identifier (der_x, x_1: for numpy and other "
+                 "tools that take identifiers only)")
+      ->check(CLI::IsMember({"modelica", "identifier"}));
 }
 
 std::optional<double> parseNumber(std::string_view text) {
@@ -141,6 +145,9 @@ ResolvedRun resolveRunOptions(const RunOptions& o, const ExperimentDefaults& e, 
   if (!o.outputs.empty()) s.columns = selectColumns(model, o.outputs, o.invariants);
   s.parameters = evaluateParameters(model, parameterOverrides(model, o.parameters));
   run.outputPath = o.outputPath;
+  if (o.csvNames != "modelica" && o.csvNames != "identifier")
+    throw UsageError(fmt::format("--csv-names must be modelica or identifier (got '{}')", o.csvNames));
+  run.csvNames = o.csvNames == "identifier" ? ColumnNaming::Identifier : ColumnNaming::Modelica;
   run.stats = o.stats;
   return run;
 }

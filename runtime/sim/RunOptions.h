@@ -9,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include "output/ColumnNames.h"
 #include "qdot/model_abi.h"
 #include "sim/Names.h"
 #include "sim/Simulation.h"
@@ -28,6 +29,7 @@ struct RunOptions {
   bool stats = false;                   ///< --stats
   bool invariants = false;              ///< --invariants
   std::string linearSolver = "auto";    ///< --linear-solver dense|klu|auto
+  std::string csvNames = "modelica";    ///< --csv-names modelica|identifier
 };
 
 /// The model's experiment annotation, as far as it gives values.
@@ -40,7 +42,7 @@ inline constexpr double kDefaultIntervals = 500;  ///< output intervals over [st
 inline constexpr double kDefaultRtol = 1e-6;
 
 /// Adds --start --stop --interval --rtol --atol -p --outputs -o --stats --invariants
-/// --linear-solver to app, storing into options (which must outlive the parse).
+/// --linear-solver --csv-names to app, storing into options (which must outlive the parse).
 void addRunOptions(CLI::App& app, RunOptions& options);
 
 /// The whole of text as a finite number (std::from_chars, no trailing characters), or nullopt.
@@ -71,6 +73,7 @@ std::vector<double> evaluateParameters(const QdotModel& model, const ParameterOv
 struct ResolvedRun {
   SimulationSettings settings;
   std::string outputPath;  ///< empty = standard output
+  ColumnNaming csvNames = ColumnNaming::Modelica;
   bool stats = false;
 };
 

@@ -63,6 +63,10 @@ bytes=$("$qdot" check /tmp/qdot_cli_binary.$$.qd 2>&1 | wc -c)
 if [ "$bytes" -lt 2000 ]; then pass=$((pass + 1)); else echo "FAIL binary-file-short: $bytes bytes of diagnostics"; fail=$((fail + 1)); fi
 contains binary-file-says "this is not a text file" "$qdot" check /tmp/qdot_cli_binary.$$.qd
 rm -f /tmp/qdot_cli_binary.$$.qd
+contains csv-names-identifier "time,th_1," "$qdot" run "$src/examples/pendulum/nlink.qd" --stop 0.01 --csv-names=identifier
+check csv-names-bad 2 "$qdot" run "$src/examples/pendulum/nlink.qd" --csv-names=python
+check parameter-out-of-range 2 "$qdot" run "$src/examples/textbook/utube.qd" -p rho=1e400
+contains parameter-out-of-range-says "out of range" "$qdot" run "$src/examples/textbook/utube.qd" -p rho=1e400
 for f in "$src"/examples/*/*.qd; do
   check "json-$(basename "$f")" 0 sh -c "'$qdot' equations '$f' --json | python3 -m json.tool"
 done

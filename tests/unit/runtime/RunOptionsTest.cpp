@@ -89,6 +89,13 @@ TEST(RunOptionsParse, AllOptionsReachTheResolvedRun) {
   EXPECT_THROW(parse({"--linear-solver", "lu"}), CLI::ValidationError);
 }
 
+TEST(RunOptionsParse, CsvNames) {
+  EXPECT_EQ(resolve({}).csvNames, ColumnNaming::Modelica);
+  EXPECT_EQ(resolve({"--csv-names", "modelica"}).csvNames, ColumnNaming::Modelica);
+  EXPECT_EQ(resolve({"--csv-names=identifier"}).csvNames, ColumnNaming::Identifier);
+  EXPECT_THROW(parse({"--csv-names", "python"}), CLI::ValidationError);
+}
+
 TEST(RunOptionsValidation, TolerancesMustBePositive) {
   EXPECT_EQ(usageError({"--rtol", "0"}), "--rtol must be positive (got 0)");
   EXPECT_EQ(usageError({"--rtol", "-1e-6"}), "--rtol must be positive (got -1e-06)");
