@@ -94,7 +94,8 @@ void timeCallbacks(QdotModel& model) {
 
 rt::SimulationResult simulateOnce(const QdotModel& model, const rt::ResolvedRun& run) {
   std::unique_ptr<rt::CsvWriter> writer =
-      run.outputPath.empty() ? std::make_unique<rt::CsvWriter>(std::cout) : rt::CsvWriter::openFile(run.outputPath);
+      run.outputPath.empty() ? std::make_unique<rt::CsvWriter>(std::cout, run.csvNames)
+                             : rt::CsvWriter::openFile(run.outputPath, run.csvNames);
   rt::SimulationResult result = rt::simulate(model, run.settings, *writer);
   if (!result.success) throw std::runtime_error(result.message);
   return result;

@@ -134,22 +134,47 @@ int Flattener::derivativeVariable(int var, SourceRange where) {
   return index;
 }
 
+// A declaration's value, created on first use. Declarations may use each other in any order, and a
+// chain of them (a0 = a1 + 1, a1 = a2 + 1, …) may be as long as the model: resolving them by
+// recursion would let the model decide the depth of the stack. So the first use runs a work list
+// instead: `pending_` holds the declarations waiting for one another, innermost last. Lowering the
+// innermost one that meets a declaration not yet resolved abandons it (NeedFirst), resolves that
+// one first and then lowers it again; declarations already resolved are looked up, so every
+// declaration is lowered at most once more than it has unresolved dependencies, in the order (and
+// with the side effects in the order) that the recursion had. A use of a pending declaration
+// closes a cycle. (The price: a binding naming k declarations not yet resolved is lowered k + 1
+// times, so a literal array of 10⁴ forward references takes seconds; models name a few.)
 const Value& Flattener::valueOf(const Declaration& d, SourceRange use) {
   if (auto it = declValues_.find(&d); it != declValues_.end()) return it->second;
   if (failed_.count(&d)) throw FlattenAbort{};
-  if (!inProgress_.insert(&d).second)
+  if (inProgress_.count(&d))
     fail(use, DiagCode::E0312, "the definition of '" + d.name + "' depends on itself",
          "break the cycle: a definition or parameter cannot refer to itself, directly or through others");
-  Value v;
+  if (!pending_.empty()) throw NeedFirst{&d};
+  pending_.push_back(&d);
+  inProgress_.insert(&d);
+  while (!pending_.empty()) resolveInnermost();
+  return declValues_.at(&d);
+}
+
+void Flattener::resolveInnermost() {
+  const Declaration* d = pending_.back();
+  size_t scalarsBefore = scalars_;  // the retry counts this declaration's scalars again
   try {
-    v = createDeclaration(d, m_.symbols.at(d.name));
-  } catch (...) {
-    inProgress_.erase(&d);
-    failed_.insert(&d);
+    Value v = createDeclaration(*d, m_.symbols.at(d->name));
+    declValues_.emplace(d, std::move(v));
+    inProgress_.erase(d);
+    pending_.pop_back();
+  } catch (const NeedFirst& first) {
+    scalars_ = scalarsBefore;
+    pending_.push_back(first.decl);
+    inProgress_.insert(first.decl);
+  } catch (...) {  // an error: every declaration waiting for this one fails with it
+    failed_.insert(pending_.begin(), pending_.end());
+    pending_.clear();
+    inProgress_.clear();
     throw;
   }
-  inProgress_.erase(&d);
-  return declValues_.emplace(&d, std::move(v)).first->second;
 }
 
 std::vector<int> Flattener::evaluateDims(const Declaration& d) {
@@ -177,6 +202,11 @@ Value Flattener::createDeclaration(const Declaration& d, const sema::ModelSymbol
         if (!v.elems[i]->isConstant())
           fail(d.binding->range, DiagCode::E0313, "the value of '" + d.name + "' must be known at compile time",
                "constants and Integer parameters may only depend on literals and other constants");
+        else if (!std::isfinite(v.elems[i]->value))  // here, where it is folded: later it is only an `inf` in an equation
+          fail(d.binding->range, DiagCode::E0314,
+               "the value of '" + d.name + "' is not a finite number (it evaluates to " +
+                   sym::toString(ctx_, v.elems[i]) + ")",
+               "look for a division by zero or an overflow in this expression");
         else if (s.kind == SymbolKind::IntegerParameter && v.elems[i]->value != std::floor(v.elems[i]->value))
           fail(d.binding->range, DiagCode::E0313, "Integer parameter '" + d.name + "' has a non-integer value");
       return v;
@@ -216,7 +246,9 @@ void Flattener::reserveVariables(size_t count) {
   if (vars.size() + count > vars.capacity()) vars.reserve(std::max(vars.size() + count, 2 * vars.capacity()));
 }
 
+// Once per declaration: lowering it again after a dependency was resolved finds them here.
 Value Flattener::variablesFor(const Declaration& d, const std::vector<int>& shape, VarRole role) {
+  if (auto it = declVariables_.find(&d); it != declVariables_.end()) return it->second;
   Value v{shape, {}};
   std::vector<std::string> names = scalarNames(d.name, shape);
   // a coordinate brings its velocity and acceleration
@@ -227,7 +259,7 @@ Value Flattener::variablesFor(const Declaration& d, const std::vector<int>& shap
     addVariable({.role = role, .symbol = symbol, .declRange = d.nameRange, .description = d.description});
     v.elems.push_back(symbol);
   }
-  return v;
+  return declVariables_.emplace(&d, std::move(v)).first->second;
 }
 
 void Flattener::checkShape(const Value& v, const std::vector<int>& shape, SourceRange r, const std::string& what) {

@@ -84,6 +84,11 @@ std::string shapeText(const std::vector<int>& shape);
 /// Thrown after an error has been reported, to abandon the current statement and go on with the next.
 struct FlattenAbort {};
 
+/// Thrown while lowering a declaration that uses `decl`, not yet resolved: resolve that one first.
+struct NeedFirst {
+  const ast::Declaration* decl;
+};
+
 class Flattener {
  public:
   Flattener(const sema::CheckedModel& m, sym::Context& ctx, DiagnosticEngine& diags, FlattenLimits limits);
@@ -111,13 +116,16 @@ class Flattener {
   SourceRange derivativeSite_;                       ///< the der() being expanded (for E0311)
 
   std::unordered_map<const ast::Declaration*, Value> declValues_;
-  std::unordered_set<const ast::Declaration*> inProgress_;
+  std::unordered_map<const ast::Declaration*, Value> declVariables_;  ///< a declaration's variables, made once
+  std::vector<const ast::Declaration*> pending_;  ///< declarations waiting for one another, innermost last
+  std::unordered_set<const ast::Declaration*> inProgress_;  ///< the same, to find a cycle quickly
   std::unordered_set<const ast::Declaration*> failed_;  ///< already reported; later uses abort quietly
   std::vector<std::pair<std::string, sym::Expr>> iterators_;  ///< innermost last
   std::vector<std::pair<const Value*, int>> endContext_;      ///< (array, dimension) being subscripted, for `end`
 
   // Flatten.cpp
   const Value& valueOf(const ast::Declaration& d, SourceRange use);
+  void resolveInnermost();
   Value createDeclaration(const ast::Declaration& d, const sema::ModelSymbol& s);
   std::vector<int> evaluateDims(const ast::Declaration& d);
   Value variablesFor(const ast::Declaration& d, const std::vector<int>& shape, VarRole role);

@@ -230,8 +230,14 @@ class Checker {
     for (const auto& [k, v] : m_.symbols) candidates.push_back(k);
     std::string guess = closestName(first, candidates);
     diags_.error(n.partRanges.empty() ? n.range : n.partRanges[0], DiagCode::E0202, "unknown name '" + first + "'",
-                 guess.empty() ? "declare it, e.g. parameter Real " + first + " = 1;"
-                               : "did you mean '" + guess + "'?");
+                 isEnergyKeyword(first) ? "'" + first + " = expr;' states an energy: write it in the mechanics section"
+                 : guess.empty()        ? "declare it, e.g. parameter Real " + first + " = 1;"
+                                        : "did you mean '" + guess + "'?");
+  }
+
+  // The words that start a mechanics statement; written in an equation section they are names.
+  static bool isEnergyKeyword(const std::string& name) {
+    return name == "kinetic" || name == "potential" || name == "dissipation";
   }
 
   void checkCall(const CallExpr& c) {

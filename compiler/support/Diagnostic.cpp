@@ -14,20 +14,58 @@ const char* severityName(Severity s) {
   return "error";
 }
 
-// Prints "   | line" and a caret line under [begin, end) of that line (clamped to the line).
+// The most columns of a source line echoed under a diagnostic: a longer line (a generated model,
+// a binary file read by mistake) is shown as a window around the caret, cut with "…" marks.
+constexpr size_t kMaxShownBytes = 120;
+constexpr size_t kBytesBeforeCaret = 40;
+
+// Bytes of the valid UTF-8 character starting at s[i] (0 if none).
+size_t utf8Length(std::string_view s, size_t i) {
+  auto c = static_cast<unsigned char>(s[i]);
+  size_t n = c >= 0xF0 && c <= 0xF4 ? 4 : c >= 0xE0 && c < 0xF0 ? 3 : c >= 0xC2 && c < 0xE0 ? 2 : 0;
+  if (n == 0 || i + n > s.size()) return 0;
+  for (size_t k = 1; k < n; ++k)
+    if ((static_cast<unsigned char>(s[i + k]) & 0xC0) != 0x80) return 0;
+  return n;
+}
+
+// Echoes the character at text[i] as one column: tabs as spaces (the caret line counts columns,
+// not tab stops), control bytes and bytes that are not UTF-8 as '?', a UTF-8 character as itself.
+// Returns the bytes it took.
+size_t echoCharacter(std::string& out, std::string_view text, size_t i) {
+  auto c = static_cast<unsigned char>(text[i]);
+  size_t n = c >= 0x80 ? utf8Length(text, i) : 1;
+  if (n > 1) out.append(text.substr(i, n));
+  else out += c == '\t' ? ' ' : (c < 0x20 || c >= 0x7F) ? '?' : static_cast<char>(c);
+  return n > 1 ? n : 1;
+}
+
+// Prints "   | line" and a caret line under [begin, end) of that line (clamped to the line and to
+// the part of it that is shown).
 void renderSnippet(std::ostream& os, const SourceManager& sm, SourceRange r) {
   LineCol lc = sm.lineCol(r.file, r.begin);
   std::string_view text = sm.lineText(r.file, lc.line);
   std::string num = std::to_string(lc.line);
   std::string pad(num.size(), ' ');
-  std::string shown;
-  for (char c : text) shown += (c == '\t') ? ' ' : (static_cast<unsigned char>(c) < 32 ? '?' : c);
+  size_t col = std::min<size_t>(lc.col - 1, text.size());
+  size_t stop = std::min<size_t>(col + std::max<uint32_t>(1, r.end > r.begin ? r.end - r.begin : 1), text.size());
+  size_t first = 0, last = text.size();  // the shown bytes [first, last)
+  if (text.size() > kMaxShownBytes) {
+    first = std::min(col > kBytesBeforeCaret ? col - kBytesBeforeCaret : 0, text.size() - kMaxShownBytes);
+    last = first + kMaxShownBytes;
+  }
+  std::string shown = first > 0 ? "…" : "";
+  size_t columns = first > 0 ? 1 : 0, caret = columns, caretEnd = 0;
+  for (size_t i = first; i < last; ++columns) {
+    if (i <= col) caret = columns;
+    if (i < stop) caretEnd = columns + 1;
+    i += echoCharacter(shown, text, i);
+  }
+  if (col >= last) caret = columns;
+  if (last < text.size()) shown += "…";
+  size_t width = caretEnd > caret ? caretEnd - caret : 1;
   os << ' ' << pad << " |\n" << ' ' << num << " | " << shown << '\n';
-  size_t col = lc.col - 1;
-  size_t len = std::max<size_t>(1, r.end > r.begin ? r.end - r.begin : 1);
-  if (col > text.size()) col = text.size();
-  len = std::min(len, std::max<size_t>(1, text.size() - std::min(col, text.size())));
-  os << ' ' << pad << " | " << std::string(col, ' ') << '^' << std::string(len - 1, '~') << '\n';
+  os << ' ' << pad << " | " << std::string(caret, ' ') << '^' << std::string(width - 1, '~') << '\n';
 }
 
 }  // namespace

@@ -56,6 +56,13 @@ bool isTokenStartOrSpace(unsigned char c) {
 Lexer::Lexer(const SourceManager& sm, uint32_t file, DiagnosticEngine& diags)
     : file_(file), text_(sm.text(file)), diags_(diags) {
   if (text_.substr(0, 3) == "\xEF\xBB\xBF") pos_ = 3;  // a UTF-8 byte-order mark is not text
+  // No text file has a NUL byte: one error for the file, not one per run of bad bytes in it.
+  if (size_t nul = text_.find('\0'); nul != std::string_view::npos) {
+    pos_ = nul + 1;
+    error({file_, static_cast<uint32_t>(nul), static_cast<uint32_t>(nul + 1)}, DiagCode::E0102,
+          "this is not a text file (it has a NUL byte)", "give qdot a model source file (.qd)");
+    pos_ = text_.size();
+  }
 }
 
 char Lexer::peekChar(size_t ahead) const {

@@ -33,15 +33,16 @@ std::string csvField(std::string_view text) {
   return quoted;
 }
 
-CsvWriter::CsvWriter(std::ostream& out) : out_(&out), path_("standard output") {}
+CsvWriter::CsvWriter(std::ostream& out, ColumnNaming naming)
+    : out_(&out), path_("standard output"), naming_(naming) {}
 
-CsvWriter::CsvWriter(std::unique_ptr<std::ofstream> file, std::string path)
-    : file_(std::move(file)), out_(file_.get()), path_(std::move(path)) {}
+CsvWriter::CsvWriter(std::unique_ptr<std::ofstream> file, std::string path, ColumnNaming naming)
+    : file_(std::move(file)), out_(file_.get()), path_(std::move(path)), naming_(naming) {}
 
-std::unique_ptr<CsvWriter> CsvWriter::openFile(const std::string& path) {
+std::unique_ptr<CsvWriter> CsvWriter::openFile(const std::string& path, ColumnNaming naming) {
   auto file = std::make_unique<std::ofstream>(path, std::ios::out | std::ios::trunc | std::ios::binary);
   if (!*file) throw std::runtime_error("cannot open " + path + " for writing: " + std::strerror(errno));
-  return std::unique_ptr<CsvWriter>(new CsvWriter(std::move(file), path));
+  return std::unique_ptr<CsvWriter>(new CsvWriter(std::move(file), path, naming));
 }
 
 void CsvWriter::writeLine() {
@@ -53,6 +54,8 @@ void CsvWriter::writeLine() {
 }
 
 void CsvWriter::begin(std::span<const std::string> columnNames) {
+  std::vector<std::string> identifiers;
+  if (naming_ == ColumnNaming::Identifier) columnNames = identifiers = identifierNames(columnNames);
   line_ = "time";
   for (const std::string& name : columnNames) {
     line_ += ',';

@@ -9,6 +9,7 @@
 #include <string>
 #include <string_view>
 
+#include "output/ColumnNames.h"
 #include "output/ResultSink.h"
 
 namespace qdot::rt {
@@ -24,9 +25,9 @@ std::string csvField(std::string_view text);
 class CsvWriter final : public ResultSink {
  public:
   /// Writes to out (e.g. std::cout); out must outlive the writer.
-  explicit CsvWriter(std::ostream& out);
+  explicit CsvWriter(std::ostream& out, ColumnNaming naming = ColumnNaming::Modelica);
   /// Opens (truncates) path; throws std::runtime_error with the reason if it cannot.
-  static std::unique_ptr<CsvWriter> openFile(const std::string& path);
+  static std::unique_ptr<CsvWriter> openFile(const std::string& path, ColumnNaming naming = ColumnNaming::Modelica);
 
   void begin(std::span<const std::string> columnNames) override;
   /// Throws std::runtime_error if the stream fails (disk full, closed pipe).
@@ -34,13 +35,14 @@ class CsvWriter final : public ResultSink {
   void finish() override;
 
  private:
-  CsvWriter(std::unique_ptr<std::ofstream> file, std::string path);
+  CsvWriter(std::unique_ptr<std::ofstream> file, std::string path, ColumnNaming naming);
   void writeLine();
 
   std::unique_ptr<std::ofstream> file_;
   std::ostream* out_;
   std::string path_;
   std::string line_;
+  ColumnNaming naming_;
 };
 
 }  // namespace qdot::rt

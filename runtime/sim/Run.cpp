@@ -38,7 +38,8 @@ ExitCode runModel(const QdotModel& model, const RunOptions& options, const Exper
   }
   std::unique_ptr<CsvWriter> writer;
   try {
-    writer = run.outputPath.empty() ? std::make_unique<CsvWriter>(csvOut) : CsvWriter::openFile(run.outputPath);
+    writer = run.outputPath.empty() ? std::make_unique<CsvWriter>(csvOut, run.csvNames)
+                                    : CsvWriter::openFile(run.outputPath, run.csvNames);
   } catch (const std::exception& e) {
     log << "error: " << e.what() << '\n';
     return ExitCode::SimulationFailed;

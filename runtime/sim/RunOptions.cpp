@@ -7,6 +7,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <stdexcept>
 
 #include "ida/ModelCheck.h"
@@ -30,6 +31,10 @@ void addRunOptions(CLI::App& app, RunOptions& o) {
   app.add_flag("--invariants", o.invariants, "add the model's invariants (energy, momenta) as columns");
   app.add_option("--linear-solver", o.linearSolver, "dense, klu or auto (default auto)")
       ->check(CLI::IsMember({"auto", "dense", "klu"}));
+  app.add_option("--csv-names", o.csvNames,
+                 "CSV header: modelica (der(x), x[1]; default) or identifier (der_x, x_1: for numpy and other "
+                 "tools that take identifiers only)")
+      ->check(CLI::IsMember({"modelica", "identifier"}));
 }
 
 std::optional<double> parseNumber(std::string_view text) {
@@ -38,6 +43,20 @@ std::optional<double> parseNumber(std::string_view text) {
   auto [stop, ec] = std::from_chars(text.data(), end, value);
   if (text.empty() || ec != std::errc() || stop != end || !std::isfinite(value)) return std::nullopt;
   return value;
+}
+
+std::string numberRejection(std::string_view text) {
+  double value = 0;
+  const char* end = text.data() + text.size();
+  auto [stop, ec] = std::from_chars(text.data(), end, value);
+  if (ec == std::errc::result_out_of_range && stop == end) {  // a number, but not a double's
+    bool tooLarge = std::fabs(std::strtod(std::string(text).c_str(), nullptr)) > 1;
+    return tooLarge ? fmt::format("is out of range: '{}' is larger than the largest number (about 1.8e308)", text)
+                    : fmt::format("is out of range: '{}' is closer to zero than the smallest number (about 4.9e-324); "
+                                  "write 0 if zero is meant",
+                                  text);
+  }
+  return fmt::format("is not a number: '{}'", text);
 }
 
 namespace {
@@ -87,7 +106,7 @@ ParameterOverrides parameterOverrides(const QdotModel& model, const std::vector<
     std::string_view text = std::string_view(assignment).substr(eq + 1);
     std::size_t i = parameterIndex(model, name);
     std::optional<double> value = parseNumber(text);
-    if (!value) throw UsageError(fmt::format("the value of parameter '{}' is not a number: '{}'", name, text));
+    if (!value) throw UsageError(fmt::format("the value of parameter '{}' {}", name, numberRejection(text)));
     if (result.overridden[i])
       throw UsageError(fmt::format("parameter '{}' is given twice (-p {} and -p {})", name, givenAs[i], assignment));
     result.given[i] = *value;
@@ -126,6 +145,9 @@ ResolvedRun resolveRunOptions(const RunOptions& o, const ExperimentDefaults& e, 
   if (!o.outputs.empty()) s.columns = selectColumns(model, o.outputs, o.invariants);
   s.parameters = evaluateParameters(model, parameterOverrides(model, o.parameters));
   run.outputPath = o.outputPath;
+  if (o.csvNames != "modelica" && o.csvNames != "identifier")
+    throw UsageError(fmt::format("--csv-names must be modelica or identifier (got '{}')", o.csvNames));
+  run.csvNames = o.csvNames == "identifier" ? ColumnNaming::Identifier : ColumnNaming::Modelica;
   run.stats = o.stats;
   return run;
 }

@@ -9,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include "output/ColumnNames.h"
 #include "qdot/model_abi.h"
 #include "sim/Names.h"
 #include "sim/Simulation.h"
@@ -28,6 +29,7 @@ struct RunOptions {
   bool stats = false;                   ///< --stats
   bool invariants = false;              ///< --invariants
   std::string linearSolver = "auto";    ///< --linear-solver dense|klu|auto
+  std::string csvNames = "modelica";    ///< --csv-names modelica|identifier
 };
 
 /// The model's experiment annotation, as far as it gives values.
@@ -40,11 +42,16 @@ inline constexpr double kDefaultIntervals = 500;  ///< output intervals over [st
 inline constexpr double kDefaultRtol = 1e-6;
 
 /// Adds --start --stop --interval --rtol --atol -p --outputs -o --stats --invariants
-/// --linear-solver to app, storing into options (which must outlive the parse).
+/// --linear-solver --csv-names to app, storing into options (which must outlive the parse).
 void addRunOptions(CLI::App& app, RunOptions& options);
 
 /// The whole of text as a finite number (std::from_chars, no trailing characters), or nullopt.
 std::optional<double> parseNumber(std::string_view text);
+
+/// Why parseNumber rejects text, as the end of a sentence about it: "is not a number: 'x'", or
+/// "is out of range: …" for a number too large (1e400) or too close to zero (1e-400) for a double.
+/// (An underflow is refused rather than taken as 0: a value the user wrote is never changed silently.)
+std::string numberRejection(std::string_view text);
 
 /// The given/overridden arrays of QdotModel::parameters.
 struct ParameterOverrides {
@@ -53,7 +60,8 @@ struct ParameterOverrides {
 };
 
 /// Parses the -p NAME=VALUE list against the model's parameter names. Throws UsageError for a
-/// missing '=', an unknown name (suggesting the closest), a value that is not a finite number,
+/// missing '=', an unknown name (suggesting the closest), a value that is not a finite number (or
+/// out of a double's range),
 /// or a parameter given twice.
 ParameterOverrides parameterOverrides(const QdotModel& model, const std::vector<std::string>& assignments);
 
@@ -65,6 +73,7 @@ std::vector<double> evaluateParameters(const QdotModel& model, const ParameterOv
 struct ResolvedRun {
   SimulationSettings settings;
   std::string outputPath;  ///< empty = standard output
+  ColumnNaming csvNames = ColumnNaming::Modelica;
   bool stats = false;
 };
 

@@ -41,6 +41,37 @@ contains utube-equation "x:  rho*A*l*der(der(x)) + 2*rho*A*g*x = 0" "$qdot" equa
 contains utube-integral "jacobi (Jacobi integral, conserved)" "$qdot" equations "$src/examples/textbook/utube.qd"
 contains caret "^~~" "$qdot" check "$src/tests/diagnostics/unknown_name.qd"
 contains location "unknown_name.qd:6:17: error[E0202]: unknown name 'mas'" "$qdot" check "$src/tests/diagnostics/unknown_name.qd"
+contains energy-help "write it in the mechanics section" "$qdot" check "$src/tests/diagnostics/energy_in_equation_section.qd"
+# A chain of 10^5 definitions (parameters) a0 = a1 + 1, ..., declared so that every use is a forward
+# reference: no stage may recurse along it (4 500 links overflowed the flattener's stack). The run
+# writes y = a0 = a_N + 10^5 at t = 0.
+chain() {  # chain FILE DECLARATION LAST
+  awk -v decl="$2" -v last="$3" 'BEGIN {
+    n = 100000
+    print "model Chain\n  coordinate Real x(start = 1);\n  output Real y = a0;"
+    for (i = 0; i < n; i++) printf "  %s a%d = a%d + 1;\n", decl, i, i + 1
+    printf "  %s a%d = %s;\n", decl, n, last
+    print "mechanics\n  kinetic = 0.5*der(x)^2;\n  potential = 0.5*x^2;\nend Chain;" }' >"$1"
+}
+chain /tmp/qdot_cli_chain.$$.qd "Real" "x"
+chain /tmp/qdot_cli_pchain.$$.qd "parameter Real" "1"
+for f in /tmp/qdot_cli_chain.$$.qd /tmp/qdot_cli_pchain.$$.qd; do
+  check "chain-check" 0 "$qdot" check "$f"
+  check "chain-equations" 0 "$qdot" equations "$f"
+  contains "chain-run" "0,1,0,100001" "$qdot" run "$f" --stop 0.1
+done
+rm -f /tmp/qdot_cli_chain.$$.qd /tmp/qdot_cli_pchain.$$.qd
+# A binary file given by mistake (here qdot itself): one short error, not a screenful per byte run.
+head -c 300000 "$qdot" >/tmp/qdot_cli_binary.$$.qd
+check binary-file 1 "$qdot" check /tmp/qdot_cli_binary.$$.qd
+bytes=$("$qdot" check /tmp/qdot_cli_binary.$$.qd 2>&1 | wc -c)
+if [ "$bytes" -lt 2000 ]; then pass=$((pass + 1)); else echo "FAIL binary-file-short: $bytes bytes of diagnostics"; fail=$((fail + 1)); fi
+contains binary-file-says "this is not a text file" "$qdot" check /tmp/qdot_cli_binary.$$.qd
+rm -f /tmp/qdot_cli_binary.$$.qd
+contains csv-names-identifier "time,th_1," "$qdot" run "$src/examples/pendulum/nlink.qd" --stop 0.01 --csv-names=identifier
+check csv-names-bad 2 "$qdot" run "$src/examples/pendulum/nlink.qd" --csv-names=python
+check parameter-out-of-range 2 "$qdot" run "$src/examples/textbook/utube.qd" -p rho=1e400
+contains parameter-out-of-range-says "out of range" "$qdot" run "$src/examples/textbook/utube.qd" -p rho=1e400
 for f in "$src"/examples/*/*.qd; do
   check "json-$(basename "$f")" 0 sh -c "'$qdot' equations '$f' --json | python3 -m json.tool"
 done

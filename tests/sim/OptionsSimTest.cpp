@@ -54,6 +54,21 @@ TEST(RunOptions, OutputsSelectsColumnsInOrder) {
   EXPECT_NE(bad.log.find("did you mean 'theta'"), std::string::npos) << bad.log;
 }
 
+// Reference: docs/language.md, "Reading the results" — --csv-names=identifier renames the header
+// only (der(theta) -> der_theta); every value is the same as with the default Modelica names.
+TEST(RunOptions, CsvNamesIdentifierRenamesTheHeaderOnly) {
+  const std::vector<std::string> common = {"--stop", "0.5", "--interval", "0.05", "--invariants"};
+  auto modelica = runQdot(kGovernor, common);
+  auto args = common;
+  args.push_back("--csv-names=identifier");
+  auto identifier = runQdot(kGovernor, args);
+  ASSERT_EQ(identifier.exitCode, 0) << identifier.log;
+  EXPECT_EQ(identifier.header, (std::vector<std::string>{"time", "theta", "der_theta", "jacobi"}));
+  ASSERT_EQ(identifier.rows, modelica.rows);
+  EXPECT_EQ(identifier.col("der_theta"), modelica.col("der(theta)"));
+  EXPECT_EQ(identifier.col("jacobi"), modelica.col("jacobi"));
+}
+
 // Reference: the closed form x = cos t of tests/sim/models/leaves_domain.qd (ẍ + x = 0, x(0) = 1) and
 // runtime/README.md — a model that leaves its domain (s = sqrt(x) once x = cos t < 0, i.e. after
 // t = π/2) fails the run with exit 3, naming the time, and the rows computed before stay written.

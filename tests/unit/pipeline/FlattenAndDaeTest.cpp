@@ -98,6 +98,46 @@ end Driven;)");
   EXPECT_EQ(m.invariant("jacobi"), nullptr) << "L depends on time explicitly: no Jacobi integral";
 }
 
+// A chain a0 = a1 + 1, a1 = a2 + 1, …, aN = last, declared in the order that makes every use a
+// forward reference. (Resolved by recursion, 4 500 links overflowed the stack.)
+std::string chainModel(const std::string& declare, int links, const std::string& last) {
+  std::string text = "model Chain\n  coordinate Real x(start = 1);\n  output Real y = a0;\n";
+  for (int i = 0; i < links; ++i)
+    text += "  " + declare + " a" + std::to_string(i) + " = a" + std::to_string(i + 1) + " + 1;\n";
+  text += "  " + declare + " a" + std::to_string(links) + " = " + last + ";\n";
+  return text + "mechanics\n  kinetic = 0.5*der(x)^2;\n  potential = 0.5*x^2;\nend Chain;\n";
+}
+
+constexpr int kChainLinks = 100000;
+
+TEST(Flatten, ChainOfDefinitionsAsLongAsTheModel) {
+  CompiledModel m("chain", chainModel("Real", kChainLinks, "x"));
+  ASSERT_TRUE(m.ok());
+  ASSERT_EQ(m.dae().outputs.size(), 1u);
+  m.set("x", 0.25);
+  EXPECT_DOUBLE_EQ(m.eval(m.dae().outputs[0].value), 0.25 + kChainLinks);
+}
+
+TEST(Flatten, ChainOfParametersAsLongAsTheModel) {
+  CompiledModel m("chain", chainModel("parameter Real", kChainLinks, "2"));
+  ASSERT_TRUE(m.ok());
+  ASSERT_EQ(m.dae().parameters.size(), static_cast<size_t>(kChainLinks) + 1);
+  // each default is over the next parameter: evaluate them from the end of the chain
+  for (auto p = m.dae().parameters.rbegin(); p != m.dae().parameters.rend(); ++p) m.set(p->name, m.eval(p->value));
+  EXPECT_DOUBLE_EQ(m.eval(m.dae().outputs.at(0).value), 2.0 + kChainLinks);
+}
+
+TEST(Flatten, CycleThroughALongChainIsReportedWhereItCloses) {
+  driver::Compilation c;
+  EXPECT_FALSE(driver::compileSource(c, "cycle", chainModel("Real", kChainLinks, "a0 + x"), "", driver::Stage::Dae));
+  ASSERT_EQ(c.diags.diagnostics().size(), 1u);
+  std::ostringstream os;
+  DiagnosticEngine::renderOne(os, c.sources, c.diags.diagnostics()[0], false);
+  // in the last link's binding, where the use of a0 closes the cycle
+  EXPECT_EQ(os.str().substr(0, os.str().find('\n')),
+            "cycle:" + std::to_string(kChainLinks + 4) + ":18: error[E0312]: the definition of 'a0' depends on itself");
+}
+
 TEST(Dae, ClassifiesStatesAlgebraicsAndMasslessCoordinates) {
   // q1 has inertia; q2 is a massless node between two springs (algebraic); q3 is a damped massless
   // coordinate (first order: q3 a state, its velocity algebraic); x is a state, y algebraic.

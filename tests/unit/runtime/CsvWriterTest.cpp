@@ -69,6 +69,28 @@ TEST(CsvWriter, HeaderQuotesNamesWithCommasAndQuotes) {
   EXPECT_EQ(out.str(), "time,x,der(x),\"q[1,2]\",\"say \"\"hi\"\"\"\n0.5,1,2,3,0.25\n");
 }
 
+TEST(CsvWriter, IdentifierHeaderForToolsThatTakeIdentifiersOnly) {
+  std::ostringstream out;
+  CsvWriter writer(out, ColumnNaming::Identifier);
+  std::vector<std::string> names = {"x", "der(x)", "q[1,2]", "say \"hi\""};
+  writer.begin(names);
+  writer.row(0.5, std::vector<double>{1, 2, 3, 0.25});
+  EXPECT_EQ(out.str(), "time,x,der_x,q_1_2,say_hi\n0.5,1,2,3,0.25\n");
+}
+
+TEST(ColumnNames, ModelicaNamesBecomeIdentifiers) {
+  std::vector<std::string> names = {"x", "der(x)", "der(der(x))", "x[1]", "M[1,2]", "der(th[10])", "a.b", "2x", "E"};
+  EXPECT_EQ(identifierNames(names), (std::vector<std::string>{"x", "der_x", "der_der_x", "x_1", "M_1_2", "der_th_10",
+                                                              "a_b", "_2x", "E"}));
+}
+
+TEST(ColumnNames, CollisionsAreNumberedAndIdentifiersKeepTheirNames) {
+  // der_x is the user's own name: it keeps it, and der(x) takes the next free one
+  std::vector<std::string> names = {"der(x)", "der_x", "x[1]", "x(1)", "der_x_2", "time()"};
+  EXPECT_EQ(identifierNames(names),
+            (std::vector<std::string>{"der_x_3", "der_x", "x_1", "x_1_2", "der_x_2", "time_2"}));
+}
+
 TEST(CsvWriter, RowsAreOnDiskBeforeFinish) {
   auto path = std::filesystem::temp_directory_path() / ("qdot_csv_flush_" + std::to_string(::getpid()) + ".csv");
   auto writer = CsvWriter::openFile(path.string());

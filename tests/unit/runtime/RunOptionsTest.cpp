@@ -89,6 +89,13 @@ TEST(RunOptionsParse, AllOptionsReachTheResolvedRun) {
   EXPECT_THROW(parse({"--linear-solver", "lu"}), CLI::ValidationError);
 }
 
+TEST(RunOptionsParse, CsvNames) {
+  EXPECT_EQ(resolve({}).csvNames, ColumnNaming::Modelica);
+  EXPECT_EQ(resolve({"--csv-names", "modelica"}).csvNames, ColumnNaming::Modelica);
+  EXPECT_EQ(resolve({"--csv-names=identifier"}).csvNames, ColumnNaming::Identifier);
+  EXPECT_THROW(parse({"--csv-names", "python"}), CLI::ValidationError);
+}
+
 TEST(RunOptionsValidation, TolerancesMustBePositive) {
   EXPECT_EQ(usageError({"--rtol", "0"}), "--rtol must be positive (got 0)");
   EXPECT_EQ(usageError({"--rtol", "-1e-6"}), "--rtol must be positive (got -1e-06)");
@@ -111,7 +118,14 @@ TEST(RunOptionsValidation, ParameterMistakes) {
   EXPECT_EQ(usageError({"-p", "zeta=3"}), "unknown parameter 'zeta'; the model has: omega");
   EXPECT_EQ(usageError({"-p", "omega=3x"}), "the value of parameter 'omega' is not a number: '3x'");
   EXPECT_EQ(usageError({"-p", "omega="}), "the value of parameter 'omega' is not a number: ''");
-  EXPECT_EQ(usageError({"-p", "omega=1e999"}), "the value of parameter 'omega' is not a number: '1e999'");
+  EXPECT_EQ(usageError({"-p", "omega=1e999"}),
+            "the value of parameter 'omega' is out of range: '1e999' is larger than the largest number (about 1.8e308)");
+  EXPECT_EQ(usageError({"-p", "omega=-1e400"}),
+            "the value of parameter 'omega' is out of range: '-1e400' is larger than the largest number (about 1.8e308)");
+  EXPECT_EQ(usageError({"-p", "omega=1e-400"}),
+            "the value of parameter 'omega' is out of range: '1e-400' is closer to zero than the smallest number "
+            "(about 4.9e-324); write 0 if zero is meant");
+  EXPECT_EQ(usageError({"-p", "omega=1e400x"}), "the value of parameter 'omega' is not a number: '1e400x'");
   EXPECT_EQ(usageError({"-p", "omega=nan"}), "the value of parameter 'omega' is not a number: 'nan'");
   EXPECT_EQ(usageError({"-p", "omega"}), "-p expects NAME=VALUE, got 'omega'");
   EXPECT_EQ(usageError({"-p", "=3"}), "-p expects NAME=VALUE, got '=3'");
@@ -145,6 +159,8 @@ TEST(ParseNumber, WholeStringFiniteNumbersOnly) {
   EXPECT_FALSE(parseNumber("inf"));
   EXPECT_FALSE(parseNumber(""));
   EXPECT_FALSE(parseNumber("+1"));  // from_chars: no leading plus
+  EXPECT_EQ(parseNumber("1e-310"), 1e-310);  // subnormal, but a double
+  EXPECT_FALSE(parseNumber("1e-400"));
 }
 
 TEST(NameSuggestions, EditDistanceAndThreshold) {

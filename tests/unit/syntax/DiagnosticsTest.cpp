@@ -262,6 +262,29 @@ TEST(Rendering, NoteOnTheOpeningBracketAndMultiCharCaret) {
             "help: write 'end Pendulum;'\n");
 }
 
+TEST(Rendering, LongLineIsEchoedAsAWindowAroundTheCaret) {
+  std::string before(300, 'a'), after(300, 'b');
+  auto p = parseText("model M\n  Real x = " + before + " $ " + after + ";\nend M;\n");
+  std::string r = p->rendered();
+  std::istringstream lines(r);
+  std::string head, bar, echoed, caret;
+  std::getline(lines, head), std::getline(lines, bar), std::getline(lines, echoed), std::getline(lines, caret);
+  EXPECT_EQ(head, "test.qd:2:313: error[E0102]: unexpected character '$'");
+  // 120 bytes from 40 before the caret, cut on both sides
+  EXPECT_EQ(echoed, " 2 | …" + std::string(39, 'a') + " $ " + std::string(78, 'b') + "…");
+  EXPECT_EQ(caret, "   | " + std::string(41, ' ') + "^");
+}
+
+TEST(Rendering, CaretCountsCharactersNotBytes) {
+  auto p = parseText("model M\n  Real x \"\u03c9\u03c9\" $;\nend M;\n");  // ω is two bytes
+  EXPECT_EQ(p->rendered(),
+            "test.qd:2:17: error[E0102]: unexpected character '$'\n"
+            "   |\n"
+            " 2 |   Real x \"\u03c9\u03c9\" $;\n"
+            "   |               ^\n"
+            "help: remove it; operators are + - * / ^ = == <> < <= > >= and names use letters, digits and '_'\n");
+}
+
 // --- inputs that must neither crash nor hang ------------------------------------------------
 
 std::string wrap(const std::string& expr) { return "model M\nequation\n  x = " + expr + ";\nend M;\n"; }
@@ -339,7 +362,7 @@ TEST(Robustness, RandomBytesStopAtTheErrorLimit) {
   std::mt19937 rng(1234);
   for (int round = 0; round < 50; ++round) {
     std::string text(20000, ' ');
-    for (char& c : text) c = static_cast<char>(rng() & 0xFF);
+    for (char& c : text) c = static_cast<char>(1 + rng() % 255);  // NUL makes it one error (below)
     auto t0 = std::chrono::steady_clock::now();
     auto p = parseText(text);
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -350,6 +373,21 @@ TEST(Robustness, RandomBytesStopAtTheErrorLimit) {
     p->diags.render(os, p->sm);
     ast::printAST(os, *p->def, p->sm);
   }
+}
+
+TEST(Robustness, ABinaryFileIsOneShortError) {
+  std::mt19937 rng(7);
+  std::string text(200000, ' ');
+  for (char& c : text) c = static_cast<char>(rng() & 0xFF);
+  text.replace(0, 5, "model");
+  text[5000] = '\0';
+  for (size_t i = 0; i < 5000; ++i)
+    if (text[i] == '\0') text[i] = '?';
+  auto p = parseText(text);
+  ASSERT_EQ(p->diags.diagnostics().size(), 1u) << p->rendered().substr(0, 2000);
+  EXPECT_EQ(p->diags.diagnostics()[0].message, "this is not a text file (it has a NUL byte)");
+  EXPECT_EQ(p->diags.diagnostics()[0].range.begin, 5000u);
+  EXPECT_LT(p->rendered().size(), 1000u);
 }
 
 TEST(Robustness, RandomTokenSoupTerminates) {

@@ -198,10 +198,13 @@ TEST(Lexer, InvalidUtf8IsShownAsHex) {
   EXPECT_EQ(l->diags.diagnostics()[0].message, "unexpected characters '\\xFF\\xFE'");
 }
 
-TEST(Lexer, NulBytesAreBadCharacters) {
-  auto l = lex(std::string("a\0b", 3));
-  EXPECT_EQ(kinds(*l), (std::vector<K>{K::identifier, K::identifier}));
-  EXPECT_EQ(l->diags.errorCount(), 1u);
+// No text has a NUL byte: the file is one error (at the byte), not a token stream with holes.
+TEST(Lexer, NulByteMeansNotATextFile) {
+  auto l = lex(std::string("a\0b @ c", 7));
+  EXPECT_EQ(kinds(*l), std::vector<K>{});
+  ASSERT_EQ(l->diags.errorCount(), 1u);
+  EXPECT_EQ(l->diags.diagnostics()[0].message, "this is not a text file (it has a NUL byte)");
+  EXPECT_EQ(l->diags.diagnostics()[0].range.begin, 1u);
 }
 
 TEST(Lexer, StopsAtTheErrorLimit) {
