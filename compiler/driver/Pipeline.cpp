@@ -3,6 +3,7 @@
 // whether the stage succeeded; continueTo runs the ones not run yet.
 #include "driver/Pipeline.h"
 
+#include <charconv>
 #include <chrono>
 #include <iostream>
 #include <iterator>
@@ -45,7 +46,7 @@ bool check(Compilation& c) {
 }
 
 bool flatten(Compilation& c) {
-  c.flat = timed(c.times.flatten, [&] { return flat::flatten(*c.checked, c.ctx, c.diags, c.options.limits); });
+  c.flat = timed(c.times.flatten, [&] { return flat::flatten(*c.checked, c.ctx, c.diags, c.options.limits, c.options.structural); });
   return c.flat && !c.diags.hasErrors();
 }
 
@@ -131,6 +132,47 @@ bool compileFile(Compilation& c, const std::string& path, Stage until) {
 
 bool compileSource(Compilation& c, std::string name, std::string text, Stage until) {
   return startFrom(c, c.sources.addBuffer(std::move(name), std::move(text)), until);
+}
+
+namespace {
+
+// The scalar Integer parameter `name` of the checked model, or null.
+const ast::Declaration* integerParameter(const sema::CheckedModel& m, const std::string& name) {
+  auto it = m.symbols.find(name);
+  if (it == m.symbols.end() || it->second.kind != sema::SymbolKind::IntegerParameter) return nullptr;
+  return it->second.decl;
+}
+
+}  // namespace
+
+std::string takeStructuralParameters(Compilation& c, std::vector<std::string>& assignments) {
+  std::vector<std::string> rest;
+  for (const std::string& a : assignments) {
+    std::size_t eq = a.find('=');
+    std::string name = a.substr(0, eq);
+    const ast::Declaration* d = eq == std::string::npos ? nullptr : integerParameter(*c.checked, name);
+    if (!d) {
+      rest.push_back(a);
+      continue;
+    }
+    if (!d->dims.empty() || !d->typeDims.empty())
+      return "-p " + a + ": '" + name + "' is an array of Integer parameters; only a scalar one can be set with -p";
+    std::string text = a.substr(eq + 1);
+    long value = 0;
+    auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+    if (ec != std::errc() || end != text.data() + text.size())
+      return "-p " + a + ": '" + name + "' is an Integer parameter (structural: it is applied before compiling); give a whole number, e.g. -p " + name + "=3";
+    if (!c.options.structural.emplace(name, value).second) return "-p " + name + " is given twice";
+  }
+  assignments = std::move(rest);
+  return "";
+}
+
+std::string structuralParameterList(const Compilation& c) {
+  std::string list;
+  for (const ast::Declaration* d : c.checked->declarations)
+    if (integerParameter(*c.checked, d->name) == d) list += (list.empty() ? "" : ", ") + d->name;
+  return list;
 }
 
 bool compileFile(Compilation& c, const std::string& path, std::string_view model, Stage until) {

@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "ast/AST.h"
 #include "dae/Dae.h"
@@ -42,6 +43,7 @@ struct StageTimes {
 struct CompileOptions {
   std::string model;            ///< the model to compile; empty: the file's last model
   flat::FlattenLimits limits;   ///< size limits of flattening (tests and fuzzing lower them)
+  flat::StructuralValues structural;  ///< values of Integer parameters (see takeStructuralParameters)
   llvmbackend::JitOptions jit;  ///< what Stage::Native compiles, and how
 };
 
@@ -82,6 +84,14 @@ bool compileFile(Compilation& c, const std::string& path, Stage until);
 bool compileSource(Compilation& c, std::string name, std::string text, Stage until);
 /// Continues a successful compilation up to `until` (no-op for stages already run).
 bool continueTo(Compilation& c, Stage until);
+
+/// Integer parameters are structural: they size arrays, so their values are applied before
+/// flattening. Moves the `NAME=VALUE` assignments (qdot run -p) that name a scalar Integer parameter
+/// of the checked model (Stage::Check reached) into c.options.structural; the others stay for the
+/// run. Returns "" or what is wrong with a structural assignment (a usage error).
+std::string takeStructuralParameters(Compilation& c, std::vector<std::string>& assignments);
+/// The model's Integer parameters, for help texts: "n" (or "" if there are none).
+std::string structuralParameterList(const Compilation& c);
 
 /// Shorthands with the model name (the last model of the file when empty).
 bool compileFile(Compilation& c, const std::string& path, std::string_view model, Stage until);

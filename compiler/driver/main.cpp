@@ -46,10 +46,27 @@ void printTimings(const driver::StageTimes& t) {
             << t.kernel * 1e3 << "\n";
 }
 
+// Compiles to `until`. Values given with -p for Integer parameters (structural: they size arrays)
+// are applied before flattening; the other -p values stay in o.run.parameters for the run.
+// Returns false after a model error or a bad -p (then `code` says which).
+bool compileTo(driver::Compilation& c, Options& o, driver::Stage until, ExitCode& code) {
+  code = ExitCode::ModelError;
+  if (o.run.parameters.empty() || until <= driver::Stage::Check) return driver::compileFile(c, o.file, until);
+  if (!driver::compileFile(c, o.file, driver::Stage::Check)) return false;
+  if (std::string error = driver::takeStructuralParameters(c, o.run.parameters); !error.empty()) {
+    std::cerr << "error: " << error << "\n";
+    code = ExitCode::Usage;
+    return false;
+  }
+  return driver::continueTo(c, until);
+}
+
 // --emit=STAGE: compile up to the stage, print its output, stop.
-ExitCode emitStage(driver::Compilation& c, const Options& o) {
+ExitCode emitStage(driver::Compilation& c, Options& o) {
   driver::EmitStage stage = *driver::parseEmitStage(o.emit);
-  bool ok = driver::compileFile(c, o.file, driver::stageNeeded(stage)) && driver::emit(c, stage, std::cout);
+  ExitCode failure;
+  bool ok = compileTo(c, o, driver::stageNeeded(stage), failure) && driver::emit(c, stage, std::cout);
+  if (!ok && failure == ExitCode::Usage) return failure;
   if (o.timings) printTimings(c.times);
   if (!ok && !c.internalError.empty()) {
     c.diags.render(std::cerr, c.sources, isatty(2));
@@ -99,8 +116,9 @@ driver::Backend backendOf(const Options& o) {
 }
 
 // qdot run: compile, simulate, write the CSV.
-ExitCode run(driver::Compilation& c, const Options& o) {
-  if (!driver::compileFile(c, o.file, driver::Stage::Kernel)) return finish(c, false);
+ExitCode run(driver::Compilation& c, Options& o) {
+  ExitCode failure;
+  if (!compileTo(c, o, driver::Stage::Kernel, failure)) return failure == ExitCode::Usage ? failure : finish(c, false);
   driver::RunnableModel m = driver::makeRunnableModel(c, backendOf(o), o.run.invariants);
   if (!m.model) {
     std::cerr << "qdot: internal error: " << m.error << "\n";
@@ -122,19 +140,26 @@ ExitCode run(driver::Compilation& c, const Options& o) {
   return code;
 }
 
-ExitCode build(driver::Compilation& c, const Options& o) {
+ExitCode build(driver::Compilation& c, Options& o) {
   if (std::string why = driver::checkOutputPath(o.exe.outputPath); !why.empty()) {
     std::cerr << "qdot: error: cannot write the executable: " << why << "\n";
     return ExitCode::Usage;
   }
-  if (!driver::compileFile(c, o.file, driver::Stage::Kernel)) return finish(c, false);
+  ExitCode failure;
+  if (!compileTo(c, o, driver::Stage::Kernel, failure)) return failure == ExitCode::Usage ? failure : finish(c, false);
+  if (!o.run.parameters.empty()) {
+    std::cerr << "error: -p " << o.run.parameters.front() << ": qdot build takes values only for Integer parameters ("
+              << (driver::structuralParameterList(c).empty() ? "this model has none" : driver::structuralParameterList(c))
+              << "), which are fixed in the executable; the others stay run-time inputs: give them to the executable\n";
+    return ExitCode::Usage;
+  }
   c.diags.render(std::cerr, c.sources, isatty(2));  // warnings, if any
   driver::ExecutableOptions exe = o.exe;
   exe.native = o.buildBackend == "llvm";
   return driver::buildExecutable(c, exe, std::cerr);
 }
 
-ExitCode dispatch(Action action, const Options& o) {
+ExitCode dispatch(Action action, Options& o) {
   driver::Compilation c;
   c.options.model = o.model;
   if (!o.emit.empty()) return emitStage(c, o);
@@ -182,9 +207,16 @@ int main(int argc, char** argv) {
                 "with --backend llvm: compile before the first step instead of starting on the VM while the JIT "
                 "compiles in the background (same results either way)");
   rt::addRunOptions(*run, o.run);
+  run->get_option("-p")->description(
+      "set a parameter: -p NAME=VALUE (repeatable). Integer parameters are structural (they size arrays): "
+      "their values are applied before compiling; the others are run-time inputs");
 
   auto* build = addCommand(app, "build", "Compile a model into a standalone executable taking the run options of 'qdot run'", o);
   build->add_option("-o,--output", o.exe.outputPath, "the executable to write (required unless --emit)");
+  build->add_option("-p,--parameter", o.run.parameters,
+                    "NAME=VALUE for an Integer parameter (it sizes arrays, so it is fixed in the executable); "
+                    "repeatable")
+      ->allow_extra_args(false);
   build->add_option("--backend", o.buildBackend, "code generator: llvm (native code, default) or bytecode (the VM, linked in)")
       ->check(CLI::IsMember({"bytecode", "llvm"}));
 

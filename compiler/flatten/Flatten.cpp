@@ -49,12 +49,13 @@ const char* roleName(VarRole r) {
 }
 
 std::optional<FlatModel> flatten(const sema::CheckedModel& model, sym::Context& ctx, DiagnosticEngine& diags,
-                                 FlattenLimits limits) {
-  return Flattener(model, ctx, diags, limits).run();
+                                 FlattenLimits limits, const StructuralValues& structural) {
+  return Flattener(model, ctx, diags, limits, structural).run();
 }
 
-Flattener::Flattener(const sema::CheckedModel& m, sym::Context& ctx, DiagnosticEngine& diags, FlattenLimits limits)
-    : m_(m), ctx_(ctx), diags_(diags), limits_(limits) {
+Flattener::Flattener(const sema::CheckedModel& m, sym::Context& ctx, DiagnosticEngine& diags, FlattenLimits limits,
+                     StructuralValues structural)
+    : m_(m), ctx_(ctx), diags_(diags), limits_(limits), structural_(std::move(structural)) {
   timeDerivative_.setRateFunction([this](Expr s) { return rateOf(s); });
 }
 
@@ -197,6 +198,10 @@ Value Flattener::createDeclaration(const Declaration& d, const sema::ModelSymbol
   switch (s.kind) {
     case SymbolKind::Constant:
     case SymbolKind::IntegerParameter: {
+      if (auto given = structural_.find(d.name); given != structural_.end()) {
+        QDOT_ASSERT(s.kind == SymbolKind::IntegerParameter && shape.empty(), "a structural value for a non-scalar or non-Integer");
+        return Value::scalar(ctx_.constant(static_cast<double>(given->second)));
+      }
       Value v = bindingValue(d, shape);
       for (size_t i = 0; i < v.size(); ++i)
         if (!v.elems[i]->isConstant())

@@ -1,7 +1,10 @@
 // Flatten: expands a checked model into a FlatModel (see FlatModel.h).
 #pragma once
 
+#include <functional>
+#include <map>
 #include <optional>
+#include <string>
 
 #include "flatten/FlatModel.h"
 #include "sema/Sema.h"
@@ -15,9 +18,14 @@ struct FlattenLimits {
   size_t maxScalars = 20'000'000;  ///< total scalar elements across all arrays and loops
 };
 
+/// Values that replace the bindings of scalar Integer parameters (`qdot run -p n=3`): the model
+/// is flattened as if they were written there, so the arrays they size take the new sizes. Every
+/// name must be a scalar Integer parameter of the model (the driver checks it against sema).
+using StructuralValues = std::map<std::string, long, std::less<>>;
+
 /// Expands arrays, loops, reductions and comprehensions; substitutes definitions and constants;
 /// builds T, V, D, forces and equations. Returns nullopt if errors were reported.
 std::optional<FlatModel> flatten(const sema::CheckedModel& model, sym::Context& ctx, DiagnosticEngine& diags,
-                                 FlattenLimits limits = {});
+                                 FlattenLimits limits = {}, const StructuralValues& structural = {});
 
 }  // namespace qdot::flat

@@ -91,7 +91,8 @@ struct NeedFirst {
 
 class Flattener {
  public:
-  Flattener(const sema::CheckedModel& m, sym::Context& ctx, DiagnosticEngine& diags, FlattenLimits limits);
+  Flattener(const sema::CheckedModel& m, sym::Context& ctx, DiagnosticEngine& diags, FlattenLimits limits,
+            StructuralValues structural = {});
   std::optional<FlatModel> run();
 
   // --- expression lowering (ExprLowering.cpp) ---
@@ -110,6 +111,7 @@ class Flattener {
   sym::Context& ctx_;
   DiagnosticEngine& diags_;
   FlattenLimits limits_;
+  StructuralValues structural_;
   FlatModel out_;
   size_t scalars_ = 0;
   sym::DirectionalDerivative timeDerivative_{ctx_};  ///< der(): memo shared by all calls

@@ -93,5 +93,31 @@ TEST(RunOptions, SolverFailureExits3AndKeepsTheRowsBefore) {
   }
 }
 
+// Integer parameters are structural (they size arrays): `-p n=...` is applied before flattening.
+// Reference: with n = 1 the N-link pendulum is the simple pendulum, whose period from rest at θ0 is
+// T = 4 K(sin(θ0/2)) / √(g/l) (K: the complete elliptic integral of the first kind, computed here
+// by the arithmetic-geometric mean, independently of qdot). At T/2 it is at −θ0, at T back at θ0.
+TEST(RunOptions, IntegerParameterSizesTheModel) {
+  const double theta0 = 0.3, omega = std::sqrt(9.81);
+  double a = 1, b = std::cos(theta0 / 2);  // AGM(1, √(1 − k²)) with k = sin(θ0/2)
+  for (int i = 0; i < 30; ++i) std::tie(a, b) = std::make_pair((a + b) / 2, std::sqrt(a * b));
+  const double period = 4 * (M_PI / (2 * a)) / omega;
+  auto r = runQdot("examples/pendulum/nlink.qd",
+                   {"-p", "n=1", "--stop", num(period), "--interval", num(period / 2), "--rtol", "1e-10"});
+  ASSERT_EQ(r.exitCode, 0) << r.log;
+  EXPECT_EQ(r.header, (std::vector<std::string>{"time", "th[1]", "der(th[1])"}));
+  ASSERT_EQ(r.rows, 3u);
+  EXPECT_NEAR(r.col("th[1]")[1], -theta0, 1e-7);
+  EXPECT_NEAR(r.col("th[1]")[2], theta0, 1e-7);
+
+  auto three = runQdot("examples/pendulum/nlink.qd", {"-p", "n=3", "-p", "m=2", "--stop", "0.1"});
+  ASSERT_EQ(three.exitCode, 0) << three.log;
+  EXPECT_EQ(three.header.size(), 7u);  // time, 3 angles, 3 velocities
+
+  auto fractional = runQdot("examples/pendulum/nlink.qd", {"-p", "n=2.5"});
+  EXPECT_EQ(fractional.exitCode, 2) << fractional.log;
+  EXPECT_NE(fractional.log.find("'n' is an Integer parameter"), std::string::npos) << fractional.log;
+}
+
 }  // namespace
 }  // namespace qdot::simtest
