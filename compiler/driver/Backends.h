@@ -22,8 +22,7 @@ enum class Backend { Tiered, Native, Bytecode };
 /// only once the tier report says it is no longer compiling).
 struct JitOutcome {
   llvmbackend::JitStats stats;
-  std::string error;    ///< why there is no model (a bug: valid kernels always load)
-  std::string warning;  ///< e.g. the JIT failed and the VM runs instead
+  std::string error;  ///< why the JIT failed ("cancelled" when the run ended first)
 };
 
 /// The model a run simulates, and how it was made.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Command-line behaviour of qdot: exit codes (0 ok, 1 model errors, 2 bad command line), output
+# Command-line behaviour of qdot: exit codes (0 ok, 1 model errors, 2 bad command line or output), output
 # of the README's first command, JSON that parses. Usage: cli_test.sh QDOT_BINARY SOURCE_DIR
 set -u
 qdot=$1
@@ -72,6 +72,27 @@ contains csv-names-identifier "time,th_1," "$qdot" run "$src/examples/pendulum/n
 check csv-names-bad 2 "$qdot" run "$src/examples/pendulum/nlink.qd" --csv-names=python
 check parameter-out-of-range 2 "$qdot" run "$src/examples/textbook/utube.qd" -p rho=1e400
 contains parameter-out-of-range-says "out of range" "$qdot" run "$src/examples/textbook/utube.qd" -p rho=1e400
+# qdot check: every check short of solving, then one summary line (or nothing with --quiet).
+contains check-summary "model UTube is valid: 3 equations in 3 unknowns (2 states, 1 algebraic), 5 parameters" \
+  "$qdot" check "$src/examples/textbook/utube.qd"
+[ -z "$("$qdot" check --quiet "$src/examples/textbook/utube.qd" 2>&1)" ] && pass=$((pass + 1)) || {
+  echo "FAIL check-quiet: printed something"; fail=$((fail + 1)); }
+check check-kernel-errors 1 "$qdot" check "$src/tests/diagnostics/implicit_initial_equation.qd"
+# A model read from standard input (-): the same output as from the file.
+check stdin-check 0 sh -c "'$qdot' check - < '$src/examples/textbook/utube.qd'"
+if [ "$("$qdot" run - --stop 0.5 < "$src/examples/textbook/utube.qd")" = "$("$qdot" run "$src/examples/textbook/utube.qd" --stop 0.5)" ]; then
+  pass=$((pass + 1)); else echo "FAIL stdin-run: differs from the file's run"; fail=$((fail + 1)); fi
+contains stdin-located "<stdin>:6:17: error[E0202]" sh -c "'$qdot' check - < '$src/tests/diagnostics/unknown_name.qd'"
+# qdot build checks its output path before compiling: a clear message and exit 2, no linker noise.
+check build-to-directory 2 "$qdot" build "$src/examples/textbook/utube.qd" -o .
+check build-to-proc 2 "$qdot" build "$src/examples/textbook/utube.qd" -o /proc/qdot-x
+contains build-to-proc-says "cannot write the executable" "$qdot" build "$src/examples/textbook/utube.qd" -o /proc/qdot-x
+check build-no-folder 2 "$qdot" build "$src/examples/textbook/utube.qd" -o /does/not/exist/x
+# Integer parameters are structural: applied before compiling; others stay run-time inputs.
+contains structural-p "time,th[1],th[2],th[3],der(th[1])" "$qdot" run "$src/examples/pendulum/nlink.qd" -p n=3 --stop 0.01
+check structural-p-fraction 2 "$qdot" run "$src/examples/pendulum/nlink.qd" -p n=2.5
+check build-runtime-p 2 "$qdot" build "$src/examples/pendulum/nlink.qd" -p m=2 -o /tmp/qdot_cli_exe.$$
+rm -f /tmp/qdot_cli_exe.$$
 for f in "$src"/examples/*/*.qd; do
   check "json-$(basename "$f")" 0 sh -c "'$qdot' equations '$f' --json | python3 -m json.tool"
 done

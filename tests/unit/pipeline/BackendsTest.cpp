@@ -1,0 +1,81 @@
+// The backends of a run (driver/Backends.h). The tiered model's background compile owns what it
+// reads: the model may outlive the Compilation it came from, and the JIT it switches to computes
+// what the VM computes, bit for bit.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstring>
+#include <thread>
+
+#include "driver/Backends.h"
+#include "unit/pipeline/CompiledModel.h"
+
+namespace qdot::driver {
+namespace {
+
+// The residual of `m` at a fixed state (the U-tube: x, der(x), E).
+std::vector<double> residualAt(const QdotModel& m) {
+  std::vector<double> p(m.nParameters), y(m.nVariables, 0.03), yp(m.nVariables, -0.2), F(m.nVariables);
+  EXPECT_EQ(m.parameters(&m, nullptr, nullptr, p.data()), 0);
+  EXPECT_EQ(m.residual(&m, 0.5, y.data(), yp.data(), p.data(), F.data()), 0);
+  return F;
+}
+
+TEST(Backends, TieredModelOutlivesItsCompilation) {
+  const std::string text = test::readSource("examples/textbook/utube.qd");
+  RunnableModel tiered;
+  {
+    Compilation c;
+    ASSERT_TRUE(compileSource(c, "utube.qd", text, "", Stage::Kernel));
+    tiered = makeRunnableModel(c, Backend::Tiered, false);
+    ASSERT_TRUE(tiered.model) << tiered.error;
+    EXPECT_EQ(tiered.what, "bytecode then llvm");
+  }  // the kernels and sources of the compilation go away while the JIT may still be compiling
+  // Call the model until the JIT is ready (bounded: a compile of this model takes milliseconds).
+  auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  std::vector<double> onVm = residualAt(*tiered.model);
+  while (rt::tierReport(tiered.model.get())->compiling && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  rt::TierReport report = *rt::tierReport(tiered.model.get());
+  ASSERT_FALSE(report.compiling);
+  ASSERT_TRUE(report.ready) << tiered.jit->error;
+  std::vector<double> onJit = residualAt(*tiered.model);
+  EXPECT_GT(rt::tierReport(tiered.model.get())->secondTierCalls, 0u);
+  ASSERT_EQ(onVm.size(), onJit.size());
+  EXPECT_EQ(std::memcmp(onVm.data(), onJit.data(), onVm.size() * sizeof(double)), 0);
+}
+
+TEST(Backends, EachBackendSaysWhatItIs) {
+  const std::string text = test::readSource("examples/textbook/utube.qd");
+  for (auto [backend, what] : {std::pair{Backend::Bytecode, "bytecode"}, std::pair{Backend::Native, "llvm"}}) {
+    Compilation c;
+    ASSERT_TRUE(compileSource(c, "utube.qd", text, "", Stage::Kernel));
+    RunnableModel m = makeRunnableModel(c, backend, false);
+    ASSERT_TRUE(m.model) << m.error;
+    EXPECT_EQ(m.what, what);
+    EXPECT_EQ(m.waited, backend == Backend::Native);
+    EXPECT_FALSE(rt::tierReport(m.model.get()).has_value());
+  }
+}
+
+TEST(Pipeline, ContinueToRunsEachStageOnceAndBothBackendsFromOneCompilation) {
+  Compilation c;
+  ASSERT_TRUE(compileSource(c, "utube.qd", test::readSource("examples/textbook/utube.qd"), "", Stage::Dae));
+  EXPECT_FALSE(c.kernels);
+  ASSERT_TRUE(continueTo(c, Stage::Native));
+  EXPECT_TRUE(c.native);
+  EXPECT_FALSE(c.bytecode);  // Native does not build the bytecode
+  auto kernels = c.kernels;
+  ASSERT_TRUE(continueTo(c, Stage::Bytecode));
+  EXPECT_TRUE(c.bytecode);
+  EXPECT_EQ(c.kernels, kernels);  // not rebuilt
+}
+
+TEST(Pipeline, AMissingFileIsOneError) {
+  Compilation c;
+  EXPECT_FALSE(compileFile(c, "/does/not/exist.qd", "", Stage::Parse));
+  ASSERT_EQ(c.diags.errorCount(), 1u);
+}
+
+}  // namespace
+}  // namespace qdot::driver
