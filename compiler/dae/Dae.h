@@ -65,6 +65,7 @@ struct Dae {
   std::vector<Invariant> invariants;
   std::vector<int> coordinates;  ///< variable indices of the coordinates, in declaration order
   flat::Experiment experiment;
+  std::vector<std::string> structuralParameters;  ///< "n = 8" (flat::FlatModel::structuralParameters)
 
   size_t stateCount() const {
     size_t n = 0;

@@ -20,6 +20,7 @@ class Builder {
     dae_.range = m_.range;
     dae_.time = m_.time();
     dae_.experiment = m_.experiment;
+    dae_.structuralParameters = m_.structuralParameters;
     dae_.outputs = m_.outputs;
     addParameters();
     dae_.variables.reserve(unknownCount());

@@ -96,6 +96,9 @@ struct FlatModel {
   std::vector<Equation> constraints;         ///< g(q, t) = 0, origin.range = the statement
   std::vector<Output> outputs;
   Experiment experiment;
+  /// The scalar Integer parameters the model uses, as "n = 8": structural (they size arrays), so
+  /// fixed in what is compiled from this model (shown by executables' --help).
+  std::vector<std::string> structuralParameters;
 
   static constexpr int kTime = 0;  ///< index of `time` in variables (a keyword: no other variable has its name)
   sym::Expr time() const { return variables[kTime].symbol; }

@@ -200,9 +200,13 @@ Value Flattener::createDeclaration(const Declaration& d, const sema::ModelSymbol
     case SymbolKind::IntegerParameter: {
       if (auto given = structural_.find(d.name); given != structural_.end()) {
         QDOT_ASSERT(s.kind == SymbolKind::IntegerParameter && shape.empty(), "a structural value for a non-scalar or non-Integer");
+        out_.structuralParameters.push_back(d.name + " = " + std::to_string(given->second));
         return Value::scalar(ctx_.constant(static_cast<double>(given->second)));
       }
       Value v = bindingValue(d, shape);
+      if (s.kind == SymbolKind::IntegerParameter && shape.empty() && v.elems[0]->isConstant() &&
+          std::isfinite(v.elems[0]->value))
+        out_.structuralParameters.push_back(d.name + " = " + sym::toString(ctx_, v.elems[0]));
       for (size_t i = 0; i < v.size(); ++i)
         if (!v.elems[i]->isConstant())
           fail(d.binding->range, DiagCode::E0313, "the value of '" + d.name + "' must be known at compile time",

@@ -63,6 +63,7 @@ class Builder {
     }
     for (const auto& o : dae_.outputs) d.outputNames.push_back(o.name);
     for (const auto& inv : dae_.invariants) d.invariantNames.push_back(inv.name);
+    d.structuralParameters = dae_.structuralParameters;
   }
 
   // Coordinates and velocities that are states start fixed; another state is fixed if it has a

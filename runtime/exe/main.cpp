@@ -51,6 +51,26 @@ std::string parameterHelp(const QdotModel& model) {
   return text;
 }
 
+// The Integer parameters the executable was built with: shown by --help; -p cannot change them.
+std::string structuralHelp(const std::vector<std::string>& fixed) {
+  if (fixed.empty()) return "";
+  std::string text = "\nFixed when built (Integer parameters size the model; rebuild with qdot build -p NAME=VALUE):\n";
+  for (const auto& f : fixed) text += "  " + f + "\n";
+  return text;
+}
+
+// A -p naming one of them: a usage error that says why and what to do, or "".
+std::string structuralAssignment(const std::vector<std::string>& fixed, const std::vector<std::string>& assignments) {
+  for (const auto& a : assignments)
+    for (const auto& f : fixed) {
+      std::string name = f.substr(0, f.find(" = "));
+      if (a.substr(0, a.find('=')) == name)
+        return "-p " + a + ": '" + name + "' is an Integer parameter that sizes the model, fixed when this executable "
+               "was built (" + f + "); rebuild it with qdot build -p " + a;
+    }
+  return "";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -67,10 +87,16 @@ int main(int argc, char** argv) {
                            model->name ? model->name : "model")};
   rt::RunOptions options;
   rt::addRunOptions(app, options);
-  app.footer(parameterHelp(*model));
+  Result<bc::Module> module = bc::deserialize(bytes);
+  std::vector<std::string> fixed = module ? module->description.structuralParameters : std::vector<std::string>{};
+  app.footer(parameterHelp(*model) + structuralHelp(fixed));
   int code = 0;
   try {
     app.parse(argc, argv);
+    if (std::string why = structuralAssignment(fixed, options.parameters); !why.empty()) {
+      std::cerr << "error: " << why << "\n";
+      return toInt(ExitCode::Usage);
+    }
     code = toInt(rt::runModel(*model, options, embeddedExperiment(), std::cout, std::cerr));
   } catch (const CLI::CallForHelp& e) {
     code = app.exit(e);

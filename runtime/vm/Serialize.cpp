@@ -111,7 +111,7 @@ Function readFunction(Reader& r) {
 void writeDescription(Writer& w, const ModelDescription& d) {
   w.str(d.name);
   for (const auto* names : {&d.variableNames, &d.parameterNames, &d.parameterDescriptions, &d.outputNames,
-                            &d.invariantNames})
+                            &d.invariantNames, &d.structuralParameters})
     w.strings(*names);
   for (const auto* ints : {&d.isDifferential, &d.fixed, &d.jacobianColumnStarts, &d.jacobianRowIndices})
     w.words(*ints);
@@ -121,7 +121,7 @@ ModelDescription readDescription(Reader& r) {
   ModelDescription d;
   d.name = r.str();
   for (auto* names : {&d.variableNames, &d.parameterNames, &d.parameterDescriptions, &d.outputNames,
-                      &d.invariantNames})
+                      &d.invariantNames, &d.structuralParameters})
     *names = r.strings();
   for (auto* ints : {&d.isDifferential, &d.fixed, &d.jacobianColumnStarts, &d.jacobianRowIndices})
     *ints = r.words<int32_t>();

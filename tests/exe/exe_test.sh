@@ -109,6 +109,18 @@ check build-bad-backend 2 "$qdot" build "$utube" -o "$work/x" --backend jvm
 check build-missing-file 2 "$qdot" build "$src/does/not/exist.qd" -o "$work/x"
 check build-model-error 1 "$qdot" build "$src/tests/diagnostics/unknown_name.qd" -o "$work/x"
 [ -e "$work/x" ] && bad "build-model-error: wrote an executable" || ok
+check build-unwritable-output 2 "$qdot" build "$utube" -o /proc/qdot-exe
+
+# Integer parameters size the model: qdot build -p fixes them, the executable says so and refuses -p.
+nlink=$src/examples/pendulum/nlink.qd
+check build-structural 0 "$qdot" build "$nlink" -p n=2 -o "$work/nlink2"
+"$work/nlink2" --stop 0.01 >"$work/nlink2.csv"
+[ "$(head -1 "$work/nlink2.csv")" = "time,th[1],th[2],der(th[1]),der(th[2])" ] && ok || bad "nlink2: header $(head -1 "$work/nlink2.csv")"
+"$qdot" run "$nlink" -p n=2 --backend llvm --stop 0.01 >"$work/nlink2-run.csv"
+same nlink2-csv "$work/nlink2.csv" "$work/nlink2-run.csv"
+grep -qF "n = 2" <("$work/nlink2" --help) && ok || bad "nlink2 --help: no 'n = 2'"
+check exe-structural-p 2 "$work/nlink2" -p n=3
+grep -qF "rebuild it with qdot build -p n=3" <("$work/nlink2" -p n=3 2>&1) && ok || bad "exe -p n=3: no advice"
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

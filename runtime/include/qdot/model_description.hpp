@@ -21,6 +21,9 @@ struct ModelDescription {
   std::vector<int32_t> isDifferential;  ///< [nVariables]: 1 if y' of the variable appears
   std::vector<int32_t> fixed;           ///< [nVariables]: start value fixed during initialisation
   std::vector<int32_t> jacobianColumnStarts, jacobianRowIndices;  ///< CSC, column j = variable j
+  /// The Integer parameters, as "n = 8": they size the model, so they are fixed in what was
+  /// compiled (an executable's --help shows them; qdot build -p n=3 changes them).
+  std::vector<std::string> structuralParameters;
 
   size_t variableCount() const { return variableNames.size(); }
   size_t parameterCount() const { return parameterNames.size(); }
