@@ -40,9 +40,9 @@ ExitCode runModel(const QdotModel& model, const RunOptions& options, const Exper
   try {
     writer = run.outputPath.empty() ? std::make_unique<CsvWriter>(csvOut, run.csvNames)
                                     : CsvWriter::openFile(run.outputPath, run.csvNames);
-  } catch (const std::exception& e) {
+  } catch (const std::exception& e) {  // nothing was simulated: the output the user named is wrong
     log << "error: " << e.what() << '\n';
-    return ExitCode::SimulationFailed;
+    return ExitCode::Usage;
   }
   SimulationResult result = simulate(model, run.settings, *writer);
   report(result, run.stats, log);

@@ -87,6 +87,7 @@ contains stdin-located "<stdin>:6:17: error[E0202]" sh -c "'$qdot' check - < '$s
 check build-to-directory 2 "$qdot" build "$src/examples/textbook/utube.qd" -o .
 check build-to-proc 2 "$qdot" build "$src/examples/textbook/utube.qd" -o /proc/qdot-x
 contains build-to-proc-says "cannot write the executable" "$qdot" build "$src/examples/textbook/utube.qd" -o /proc/qdot-x
+check run-unwritable-output 2 "$qdot" run "$src/examples/textbook/utube.qd" -o /does/not/exist/out.csv
 check build-no-folder 2 "$qdot" build "$src/examples/textbook/utube.qd" -o /does/not/exist/x
 # Integer parameters are structural: applied before compiling; others stay run-time inputs.
 contains structural-p "time,th[1],th[2],th[3],der(th[1])" "$qdot" run "$src/examples/pendulum/nlink.qd" -p n=3 --stop 0.01
