@@ -1,6 +1,6 @@
 // qdot_llvm_bench: compile-time and run-time measurements of the LLVM backend (README.md).
 //   qdot_llvm_bench FILE.qd [n] [optLevel] [maxInstructionsPerFunction] [pipelineLevel] [threads] [mask] [jacobianOptLevel]
-// Runs the front end (overriding `Integer n = ...` with n if given), then JIT-compiles the kernels
+// Compiles through the driver's pipeline (overriding `Integer n = ...` with n if given), then JIT-compiles the kernels
 // and prints the compile phases, and the residual evaluation time of the JIT and the bytecode VM.
 #include <chrono>
 #include <cmath>
@@ -10,14 +10,7 @@
 #include <regex>
 #include <sstream>
 
-#include "bytecode/Emitter.h"
-#include "dae/Dae.h"
-#include "flatten/Flatten.h"
-#include "kernel/Kernel.h"
-#include "llvm/JitModel.h"
-#include "mechanics/EulerLagrange.h"
-#include "sema/Sema.h"
-#include "syntax/Parser.h"
+#include "driver/Pipeline.h"
 #include "vm/Vm.h"
 
 using namespace qdot;
@@ -61,48 +54,35 @@ int main(int argc, char** argv) {
   if (argc > 8) options.jacobianOptLevel = std::atoi(argv[8]);
 
   auto t0 = Clock::now();
-  SourceManager sources;
-  DiagnosticEngine diags;
-  sym::Context ctx;
-  uint32_t file = sources.addBuffer(argv[1], text);
-  auto ast = syntax::parse(sources, file, diags);
-  std::optional<sema::CheckedModel> checked;
-  std::optional<flat::FlatModel> flat;
-  std::optional<mech::EquationsOfMotion> eom;
-  std::optional<dae::Dae> dae;
-  if (!diags.hasErrors()) checked = sema::checkModel(*ast, "", diags);
-  if (checked && !diags.hasErrors()) flat = flat::flatten(*checked, ctx, diags);
-  if (flat) eom = mech::deriveEquationsOfMotion(*flat, ctx, diags);
-  if (eom) dae = dae::buildDae(*flat, *eom, ctx, diags);
-  if (!dae || diags.hasErrors()) {
-    diags.render(std::cerr, sources);
-    return 1;
-  }
-  kernel::KernelModule k = kernel::buildKernels(*dae, ctx, diags);
-  if (diags.hasErrors()) {
-    diags.render(std::cerr, sources);
+  driver::Compilation c;
+  c.options.jit = options;
+  if (!driver::compileSource(c, argv[1], text, "", driver::Stage::Kernel)) {
+    c.diags.render(std::cerr, c.sources);
     return 1;
   }
   double frontEnd = since(t0);
+  const kernel::KernelModule& k = *c.kernels;
   size_t instructions = 0;
   for (const auto& p : k.programs) instructions += p.code.size();
 
-  llvmbackend::JitStats stats;
   auto t1 = Clock::now();
-  Result<ModelPtr> jitModel = llvmbackend::createJitModel(k, sources, options, &stats);
+  bool compiled = driver::continueTo(c, driver::Stage::Native);
   double total = since(t1);
-  if (!jitModel) {
-    std::cerr << jitModel.error() << "\n";
+  if (!compiled) {
+    std::cerr << c.internalError << "\n";
     return 1;
   }
+  const llvmbackend::JitStats& stats = c.jitStats;
   auto t2 = Clock::now();
-  Result<ModelPtr> vmModel = vm::createModel(bytecode::emitBytecode(k, sources));
+  driver::continueTo(c, driver::Stage::Bytecode);
+  Result<ModelPtr> vmModel = vm::createModel(*c.bytecode);
   double vmBuild = since(t2);
   if (!vmModel) {
     std::cerr << vmModel.error() << "\n";
     return 1;
   }
-  QdotModel *jit = jitModel->get(), *vm = vmModel->get();
+  ModelPtr jitModel = std::move(c.native);
+  QdotModel *jit = jitModel.get(), *vm = vmModel->get();
 
   std::vector<double> p(jit->nParameters);
   jit->parameters(jit, nullptr, nullptr, p.data());
