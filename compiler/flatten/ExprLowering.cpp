@@ -42,9 +42,13 @@ double Flattener::lowerConstant(const ast::Expr& e, const char* what) {
 }
 
 long Flattener::lowerInteger(const ast::Expr& e, const char* what) {
-  double v = lowerConstant(e, what);
+  return integerValue(lowerConstant(e, what), e.range, what);
+}
+
+// Checked before the conversion: a double outside the range of `long` does not convert.
+long Flattener::integerValue(double v, SourceRange r, const char* what) {
   if (v != std::floor(v) || std::fabs(v) > 1e9)
-    fail(e.range, DiagCode::E0303, std::string(what) + " must be an Integer, but it is " + sym::toString(ctx_, ctx_.constant(v)));
+    fail(r, DiagCode::E0303, std::string(what) + " must be an Integer, but it is " + sym::toString(ctx_, ctx_.constant(v)));
   return static_cast<long>(v);
 }
 
@@ -96,7 +100,7 @@ class Flattener::EndScope {
   Flattener& f_;
 };
 
-void Flattener::checkIndex(int i, int dimSize, const ast::Expr& s) {
+void Flattener::checkIndex(long i, int dimSize, const ast::Expr& s) {
   if (i < 1 || i > dimSize)
     fail(s.range, DiagCode::E0301, "index " + std::to_string(i) + " is out of range 1:" + std::to_string(dimSize),
          "array indices start at 1 and end at the size of the dimension");
@@ -104,9 +108,9 @@ void Flattener::checkIndex(int i, int dimSize, const ast::Expr& s) {
 
 // A subscript that is a single index (not a range).
 int Flattener::subscriptIndex(const ast::Expr& s, int dimSize) {
-  int i = static_cast<int>(lowerInteger(s, "a subscript"));
+  long i = lowerInteger(s, "a subscript");
   checkIndex(i, dimSize, s);
-  return i;
+  return static_cast<int>(i);
 }
 
 std::vector<int> Flattener::subscriptIndices(const ast::Expr& s, int dimSize) {
@@ -117,8 +121,11 @@ std::vector<int> Flattener::subscriptIndices(const ast::Expr& s, int dimSize) {
     for (int i = 1; i <= dimSize; ++i) idx.push_back(i);
     return idx;
   }
-  for (Expr v : iterationValues(s)) idx.push_back(static_cast<int>(v->value));
-  for (int i : idx) checkIndex(i, dimSize, s);
+  for (Expr v : iterationValues(s)) {  // the values of a range need not be Integers: x[1.5:2.5]
+    long i = integerValue(v->value, s.range, "a subscript");
+    checkIndex(i, dimSize, s);
+    idx.push_back(static_cast<int>(i));
+  }
   return idx;
 }
 
@@ -293,7 +300,9 @@ std::vector<Expr> Flattener::iterationValues(const ast::Expr& range) {
   if (step == 0) fail(r->step->range, DiagCode::E0308, "a range step cannot be 0");
   double count = std::floor((b - a) / step + 1e-9) + 1;
   if (!(count > 0)) return {};
-  countScalars(static_cast<size_t>(count), range.range);
+  // Clamped to one past the limit, which countScalars refuses (E0310): a count like 1e300 does
+  // not convert to size_t.
+  countScalars(static_cast<size_t>(std::min(count, static_cast<double>(limits_.maxScalars) + 1)), range.range);
   std::vector<Expr> out;
   for (long i = 0; i < static_cast<long>(count); ++i) out.push_back(ctx_.constant(a + i * step));
   return out;

@@ -100,6 +100,7 @@ class Flattener {
   sym::Expr lowerScalar(const ast::Expr& e, const char* what);
   long lowerInteger(const ast::Expr& e, const char* what);
   double lowerConstant(const ast::Expr& e, const char* what);
+  long integerValue(double v, SourceRange r, const char* what);
   std::vector<sym::Expr> iterationValues(const ast::Expr& range);
   sym::Expr timeDerivative(sym::Expr e, SourceRange where);
   sym::Expr rateOf(sym::Expr symbol);
@@ -165,7 +166,7 @@ class Flattener {
   class EndScope;
   std::vector<int> subscriptIndices(const ast::Expr& s, int dimSize);
   int subscriptIndex(const ast::Expr& s, int dimSize);
-  void checkIndex(int i, int dimSize, const ast::Expr& s);
+  void checkIndex(long i, int dimSize, const ast::Expr& s);
   size_t elementOffset(const ast::IndexExpr& e, const Value& base);
   Value mapUnary(const Value& v, sym::Kind k);
 

@@ -1,8 +1,11 @@
 // libFuzzer entry point for the whole front end: parse, check, flatten, derive the equations of
-// motion, assemble the DAE, build the kernels (residual, symbolic Jacobian, CSE) and the bytecode,
-// and validate the bytecode. No input may crash, hang or violate these invariants:
-// every diagnostic is located inside the file with a stable code; a model that compiles without
-// errors yields a DAE whose equations and unknowns balance and bytecode that validates.
+// motion and assemble the DAE (Stage::Dae), build the kernels (Stage::Kernel: residual, symbolic
+// Jacobian, CSE), then continue to the bytecode (Stage::Bytecode), validate it and round-trip it
+// through its serialised form. No input may crash, hang or violate these invariants:
+// - every diagnostic has a registered code and a message and is located inside the file;
+// - a model that compiles without errors yields a DAE whose equations and unknowns balance, kernel
+//   programs in SSA form writing as many values as the description says, and bytecode that
+//   validates and reads back unchanged in size.
 #include <cstddef>
 #include <cstdint>
 #include <ostream>
@@ -11,6 +14,7 @@
 
 #include "driver/Pipeline.h"
 #include "qdot/bytecode.h"
+#include "support/DiagnosticCodes.h"
 
 namespace {
 
@@ -22,11 +26,34 @@ void check(bool ok) {
 
 void checkDiagnostics(const driver::Compilation& c, size_t size) {
   for (const auto& d : c.diags.diagnostics()) {
-    check(!d.message.empty() && d.code.size() == 5 && d.code[0] != ' ');
+    check(!d.message.empty() && static_cast<size_t>(d.code) < allDiagCodes().size());
     if (d.range.valid()) check(d.range.begin <= d.range.end && d.range.end <= size);
   }
   std::ostream null(nullptr);
   c.diags.render(null, c.sources);
+}
+
+// Instruction i defines register %i and reads only earlier registers; each program writes what the
+// description says it writes.
+void checkKernels(const kernel::KernelModule& m, size_t unknowns) {
+  check(m.variableCount() == unknowns && m.description.inconsistency().empty());
+  for (size_t p = 0; p < kModelProgramCount; ++p) {
+    const kernel::Program& program = m.programs[p];
+    check(program.outputCount == m.description.outputCount(programAt(p)));
+    for (uint32_t i = 0; i < program.code.size(); ++i) {
+      const kernel::Instr& ins = program.code[i];
+      uint32_t reads = kernel::readCount(ins.op);
+      check((reads < 1 || ins.a < i) && (reads < 2 || ins.b < i) && (reads < 3 || ins.c < i));
+      check(ins.source == UINT32_MAX || ins.source < m.sources.size());
+    }
+  }
+}
+
+void checkBytecode(const bc::Module& m) {
+  check(bc::validate(m).ok());
+  std::vector<uint8_t> bytes = bc::serialize(m);
+  Result<bc::Module> back = bc::deserialize(bytes);
+  check(back.ok() && bc::serialize(back.value()) == bytes);
 }
 
 }  // namespace
@@ -45,9 +72,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::vector<sym::Expr> residuals;
   for (const auto& e : c.dae->equations) residuals.push_back(e.residual);
   if (c.ctx.dagSize(residuals) > 5'000) return 0;
-  if (!driver::continueTo(c, driver::Stage::Bytecode)) return 0;  // E0601: reported, located
+  ok = driver::continueTo(c, driver::Stage::Kernel);
   checkDiagnostics(c, size);
-  std::string error;
-  check(bc::validate(*c.bytecode, error));
+  if (!ok) return 0;  // E06xx: what the kernels cannot compute, reported and located
+  checkKernels(*c.kernels, c.dae->variables.size());
+  check(driver::continueTo(c, driver::Stage::Bytecode) && c.internalError.empty());
+  checkBytecode(*c.bytecode);
   return 0;
 }
