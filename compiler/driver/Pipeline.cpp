@@ -111,11 +111,16 @@ bool continueTo(Compilation& c, Stage until) {
   while (c.ok && c.reached < until) {
     Stage next = static_cast<Stage>(static_cast<int>(c.reached) + 1);
     if (next == Stage::Bytecode && until == Stage::Native) next = Stage::Native;  // the other backend
-    c.ok = runStage(c, next);
-    if (c.ok) c.reached = next;
+    if (!runStage(c, next)) {
+      // The JIT failing on valid kernels (c.internalError) leaves the compilation usable: the
+      // bytecode backend can still run the model.
+      c.ok = next == Stage::Native;
+      return false;
+    }
+    c.reached = next;
   }
   if (c.ok && until == Stage::Bytecode && !c.bytecode) c.ok = emitBytecode(c);  // reached Native before
-  return c.ok;
+  return c.ok && c.reached >= until;
 }
 
 bool compileFile(Compilation& c, const std::string& path, Stage until) {

@@ -3,6 +3,7 @@
 // what the VM computes, bit for bit.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstring>
 #include <thread>
@@ -69,6 +70,18 @@ TEST(Pipeline, ContinueToRunsEachStageOnceAndBothBackendsFromOneCompilation) {
   ASSERT_TRUE(continueTo(c, Stage::Bytecode));
   EXPECT_TRUE(c.bytecode);
   EXPECT_EQ(c.kernels, kernels);  // not rebuilt
+}
+
+TEST(Pipeline, AFailedJitLeavesTheBytecodeBackend) {
+  Compilation c;
+  std::atomic<bool> cancelled{true};  // the JIT gives up at once, as when a tiered run ends first
+  c.options.jit.cancel = &cancelled;
+  ASSERT_TRUE(compileSource(c, "utube.qd", test::readSource("examples/textbook/utube.qd"), "", Stage::Kernel));
+  EXPECT_FALSE(continueTo(c, Stage::Native));
+  EXPECT_NE(c.internalError.find("cancelled"), std::string::npos) << c.internalError;
+  EXPECT_FALSE(c.diags.hasErrors());  // not the model's fault
+  EXPECT_TRUE(continueTo(c, Stage::Bytecode));
+  EXPECT_TRUE(c.bytecode);
 }
 
 TEST(Pipeline, AMissingFileIsOneError) {
