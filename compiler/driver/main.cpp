@@ -11,6 +11,7 @@
 #include "driver/Backends.h"
 #include "driver/Emit.h"
 #include "driver/Executable.h"
+#include "driver/Modes.h"
 #include "driver/Pipeline.h"
 #include "qdot/exit_code.hpp"
 #include "sim/Run.h"
@@ -19,7 +20,7 @@ namespace {
 
 using namespace qdot;
 
-enum class Action { Check, Equations, Run, Build };
+enum class Action { Check, Equations, Run, Build, Modes };
 
 struct Options {
   std::string file;
@@ -33,6 +34,7 @@ struct Options {
   rt::RunOptions run;
   driver::ExecutableOptions exe;
   std::string buildBackend = "llvm";
+  std::string at = "equilibrium";  // modes --at
 };
 
 ExitCode finish(driver::Compilation& c, bool ok) {
@@ -159,6 +161,22 @@ ExitCode build(driver::Compilation& c, Options& o) {
   return driver::buildExecutable(c, exe, std::cerr);
 }
 
+// qdot modes: natural frequencies, damping ratios and mode shapes.
+ExitCode modes(driver::Compilation& c, Options& o) {
+  ExitCode failure;
+  if (!compileTo(c, o, driver::Stage::Kernel, failure)) return failure == ExitCode::Usage ? failure : finish(c, false);
+  c.diags.render(std::cerr, c.sources, isatty(2));  // warnings, if any
+  auto at = o.at == "start" ? linear::OperatingPoint::Start : linear::OperatingPoint::Equilibrium;
+  driver::ModesResult r = driver::computeModes(c, o.run.parameters, at);
+  if (!r.error.empty()) {
+    std::cerr << "error: " << r.error << "\n";
+    return r.code;
+  }
+  if (o.json) linear::printModesJson(std::cout, r.system, r.modes);
+  else linear::printModes(std::cout, r.system, r.modes);
+  return ExitCode::Success;
+}
+
 ExitCode dispatch(Action action, Options& o) {
   driver::Compilation c;
   c.options.model = o.model;
@@ -168,6 +186,7 @@ ExitCode dispatch(Action action, Options& o) {
     case Action::Equations: return equations(c, o);
     case Action::Run: return run(c, o);
     case Action::Build: return build(c, o);
+    case Action::Modes: return modes(c, o);
   }
   return ExitCode::Internal;
 }
@@ -220,11 +239,18 @@ int main(int argc, char** argv) {
   build->add_option("--backend", o.buildBackend, "code generator: llvm (native code, default) or bytecode (the VM, linked in)")
       ->check(CLI::IsMember({"bytecode", "llvm"}));
 
+  auto* modesCmd = addCommand(app, "modes", "Natural frequencies, damping ratios and mode shapes of the linearized model", o);
+  modesCmd->add_option("-p,--parameter", o.run.parameters, "set a parameter: -p NAME=VALUE (repeatable)")
+      ->allow_extra_args(false);
+  modesCmd->add_option("--at", o.at, "linearize about the static equilibrium nearest the start values (default) or the start state")
+      ->check(CLI::IsMember({"equilibrium", "start"}));
+  modesCmd->add_flag("--json", o.json, "print JSON for tools instead of text");
+
   std::string first = argc > 1 ? argv[1] : "";
   bool known = false;
   for (const CLI::App* cmd : app.get_subcommands({})) known = known || cmd->get_name() == first;
   if (!first.empty() && first[0] != '-' && !known) {
-    std::cerr << "qdot: unknown command '" << first << "'; the commands are: check, equations, run, build (see qdot --help)\n";
+    std::cerr << "qdot: unknown command '" << first << "'; the commands are: check, equations, run, build, modes (see qdot --help)\n";
     return toInt(ExitCode::Usage);
   }
   if (argc == 1) {
@@ -237,7 +263,7 @@ int main(int argc, char** argv) {
     int code = app.exit(e);
     return code == 0 ? 0 : toInt(ExitCode::Usage);
   }
-  Action action = *check ? Action::Check : *eqs ? Action::Equations : *run ? Action::Run : Action::Build;
+  Action action = *check ? Action::Check : *eqs ? Action::Equations : *run ? Action::Run : *build ? Action::Build : Action::Modes;
   if (action == Action::Build && o.emit.empty() && o.exe.outputPath.empty()) {
     std::cerr << "qdot build: -o,--output is required (the executable to write)\nRun with --help for more information.\n";
     return toInt(ExitCode::Usage);

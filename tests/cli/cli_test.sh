@@ -94,6 +94,11 @@ contains structural-p "time,th[1],th[2],th[3],der(th[1])" "$qdot" run "$src/exam
 check structural-p-fraction 2 "$qdot" run "$src/examples/pendulum/nlink.qd" -p n=2.5
 check build-runtime-p 2 "$qdot" build "$src/examples/pendulum/nlink.qd" -p m=2 -o /tmp/qdot_cli_exe.$$
 rm -f /tmp/qdot_cli_exe.$$
+# qdot modes: the two-mass system's out-of-phase frequency √(3k/m) = √300; JSON parses; no equilibrium: exit 1.
+contains modes-two-mass "17.32050808" "$qdot" modes "$src/examples/vibration/two_mass_modes.qd"
+check modes-json 0 sh -c "'$qdot' modes '$src/examples/vibration/two_mass_modes.qd' --json | python3 -m json.tool"
+check modes-no-equilibrium 1 "$qdot" modes "$src/examples/textbook/wedge.qd"
+check modes-bad-at 2 "$qdot" modes "$src/examples/textbook/utube.qd" --at nowhere
 for f in "$src"/examples/*/*.qd; do
   check "json-$(basename "$f")" 0 sh -c "'$qdot' equations '$f' --json | python3 -m json.tool"
 done
