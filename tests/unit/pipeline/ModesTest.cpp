@@ -4,7 +4,11 @@
 //   damped oscillator: ω0 = √(k/m), ζ = c / (2√(km));
 //   U-tube (textbook 5-2): ω = √(2g/l);
 //   double pendulum, equal m and l: ω² = (g/l)(2 ∓ √2), θ2/θ1 = ±√2;
-//   simple pendulum (N-link with n = 1) about θ0 (--at start): ω = √(g cos θ0 / l).
+//   simple pendulum (N-link with n = 1) about θ0 (--at start): ω = √(g cos θ0 / l);
+//   centrifugal governor (textbook 5-3) about its relative equilibrium cos θe = (6m1+3m2+3m3) g /
+//   ((3m2+2m1) Ω² l): ω² = U''(θe) / M(θe), with the effective potential
+//   U = −(4m1+2m2+2m3) g l cos θ − (2/3 m1 + m2) Ω² l² sin²θ and M = 2 (2/3 m1 + 2(m1+m3) sin²θ + m2) l²
+//   (the model's T, written out by hand from its bars, balls and sleeve).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -86,6 +90,19 @@ TEST(Modes, SimplePendulumAboutItsStartState) {
   ASSERT_EQ(r.modes.size(), 1u);
   EXPECT_FALSE(r.system.equilibrium);
   expectRelative(r.modes[0].omega, std::sqrt(9.81 * std::cos(0.3)));
+}
+
+TEST(Modes, GovernorAboutItsRelativeEquilibrium) {
+  ModesResult r = modesOf("textbook/governor.qd", {"omega=12"});
+  ASSERT_EQ(r.error, "");
+  double m1 = 0.2, m2 = 1.0, m3 = 0.5, l = 0.25, W = 12, g = 9.81;
+  double th = std::acos((6 * m1 + 3 * m2 + 3 * m3) * g / ((3 * m2 + 2 * m1) * W * W * l));
+  double s2 = std::sin(th) * std::sin(th);
+  double M = 2 * (2.0 / 3 * m1 + 2 * (m1 + m3) * s2 + m2) * l * l;
+  double U2 = (4 * m1 + 2 * m2 + 2 * m3) * g * l * std::cos(th) - 2 * (2.0 / 3 * m1 + m2) * W * W * l * l * std::cos(2 * th);
+  ASSERT_EQ(r.modes.size(), 1u);
+  expectRelative(r.system.point[0], th, 1e-12);
+  expectRelative(r.modes[0].omega, std::sqrt(U2 / M));
 }
 
 TEST(Modes, NoEquilibriumAndBadParametersAreReported) {
