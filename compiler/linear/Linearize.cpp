@@ -139,6 +139,7 @@ Linearization linearize(const dae::Dae& d, sym::Context& ctx, const ModelValues&
   }
   for (size_t j = 0; j < n; ++j) s.coordinates.push_back(d.variables[cs[j].qVar].name);
   s.point.assign(q.data(), q.data() + n);
+  s.time = values.time;
   return out;
 }
 

@@ -32,6 +32,7 @@ struct SecondOrderSystem {
   std::vector<double> point;  ///< q* (velocities are zero at an equilibrium)
   Eigen::MatrixXd M, C, K;
   bool equilibrium = false;   ///< q* is a static equilibrium (else the start state)
+  double time = 0;            ///< the time of the point (forces that depend on time take their values then)
   int newtonIterations = 0;   ///< to find it
 };
 

@@ -31,9 +31,10 @@ void printModes(std::ostream& os, const SecondOrderSystem& s, const std::vector<
   for (const auto& c : s.coordinates) names += (names.empty() ? "" : ", ") + c;
   os << "operating point: " << names << " = " << list(s.point, ", ");
   if (s.equilibrium)
-    os << " (static equilibrium, " << s.newtonIterations << " Newton iteration" << (s.newtonIterations == 1 ? "" : "s") << ")";
+    os << " (static equilibrium at t = " << fmt::format("{:g}", s.time) << ", " << s.newtonIterations
+       << " Newton iteration" << (s.newtonIterations == 1 ? "" : "s") << ")";
   else
-    os << " (the start state)";
+    os << " (the start state at t = " << fmt::format("{:g}", s.time) << ")";
   os << "\n" << fmt::format("{:>4}  {:>16}  {:>16}  {:>12}  shape ({})\n", "mode", "omega [rad/s]", "f [Hz]", "zeta", names);
   for (size_t i = 0; i < modes.size(); ++i) {
     const Mode& m = modes[i];
