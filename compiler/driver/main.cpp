@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <optional>
 
 #include "dae/Dae.h"
 #include "driver/Backends.h"
@@ -61,6 +62,14 @@ bool compileTo(driver::Compilation& c, Options& o, driver::Stage until, ExitCode
     return false;
   }
   return driver::continueTo(c, until);
+}
+
+// compileTo(Stage::Kernel) for the commands that go on to use the model: nullopt, or the exit
+// code of the failure (its diagnostics printed).
+std::optional<ExitCode> compileToKernels(driver::Compilation& c, Options& o) {
+  ExitCode code;
+  if (compileTo(c, o, driver::Stage::Kernel, code)) return std::nullopt;
+  return code == ExitCode::Usage ? code : finish(c, false);
 }
 
 // --emit=STAGE: compile up to the stage, print its output, stop.
@@ -119,8 +128,7 @@ driver::Backend backendOf(const Options& o) {
 
 // qdot run: compile, simulate, write the CSV.
 ExitCode run(driver::Compilation& c, Options& o) {
-  ExitCode failure;
-  if (!compileTo(c, o, driver::Stage::Kernel, failure)) return failure == ExitCode::Usage ? failure : finish(c, false);
+  if (std::optional<ExitCode> failed = compileToKernels(c, o)) return *failed;
   driver::RunnableModel m = driver::makeRunnableModel(c, backendOf(o), o.run.invariants);
   if (!m.model) {
     std::cerr << "qdot: internal error: " << m.error << "\n";
@@ -147,8 +155,7 @@ ExitCode build(driver::Compilation& c, Options& o) {
     std::cerr << "qdot: error: cannot write the executable: " << why << "\n";
     return ExitCode::Usage;
   }
-  ExitCode failure;
-  if (!compileTo(c, o, driver::Stage::Kernel, failure)) return failure == ExitCode::Usage ? failure : finish(c, false);
+  if (std::optional<ExitCode> failed = compileToKernels(c, o)) return *failed;
   if (!o.run.parameters.empty()) {
     std::cerr << "error: -p " << o.run.parameters.front() << ": qdot build takes values only for Integer parameters ("
               << (driver::structuralParameterList(c).empty() ? "this model has none" : driver::structuralParameterList(c))
@@ -163,8 +170,7 @@ ExitCode build(driver::Compilation& c, Options& o) {
 
 // qdot modes: natural frequencies, damping ratios and mode shapes.
 ExitCode modes(driver::Compilation& c, Options& o) {
-  ExitCode failure;
-  if (!compileTo(c, o, driver::Stage::Kernel, failure)) return failure == ExitCode::Usage ? failure : finish(c, false);
+  if (std::optional<ExitCode> failed = compileToKernels(c, o)) return *failed;
   c.diags.render(std::cerr, c.sources, isatty(2));  // warnings, if any
   auto at = o.at == "start" ? linear::OperatingPoint::Start : linear::OperatingPoint::Equilibrium;
   driver::ModesResult r = driver::computeModes(c, o.run.parameters, at);

@@ -1,18 +1,12 @@
 // `--emit=flat`: the flattened model, one item per line. Variables in index order (time first,
 // then as the flattener created them), each term and equation in the order of the model text.
 #include "flatten/FlatPrinter.h"
+#include "qdot/number_text.hpp"
 
-#include <charconv>
 #include <ostream>
 
 namespace qdot::flat {
 namespace {
-
-std::string number(double v) {
-  char buf[32];
-  auto res = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, res.ptr);
-}
 
 // "  (utube.qd:14)", or nothing when the item has no place in the text.
 std::string at(const SourceManager& sm, SourceRange r) {
@@ -64,7 +58,7 @@ void printExperiment(std::ostream& os, const Experiment& e) {
       {"StartTime", &e.startTime}, {"StopTime", &e.stopTime}, {"Interval", &e.interval}, {"Tolerance", &e.tolerance}};
   bool any = false;
   for (const auto& [name, value] : fields)
-    if (value->has_value()) os << (any ? ", " : " ") << name << " = " << number(**value), any = true;
+    if (value->has_value()) os << (any ? ", " : " ") << name << " = " << shortestText(**value), any = true;
   os << (any ? "\n" : " (none)\n");
 }
 

@@ -1,19 +1,13 @@
 // `--emit=kernel`: the module header (names, flags, Jacobian pattern) and each program, one
 // instruction per line, with the source an instruction serves shown when it changes.
-#include <charconv>
 #include <ostream>
 
 #include "kernel/Kernel.h"
 #include "qdot/bytecode.h"
+#include "qdot/number_text.hpp"
 
 namespace qdot::kernel {
 namespace {
-
-std::string number(double v) {
-  char buf[32];
-  auto res = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, res.ptr);
-}
 
 std::string join(const std::vector<std::string>& names) {
   std::string s;
@@ -38,7 +32,7 @@ std::string operands(const Instr& ins, const Program& prog, const KernelModule& 
     case bc::Format::End:
     case bc::Format::None: return "";
     case bc::Format::Index: {
-      if (ins.op == Op::LoadConst) return number(prog.constants[ins.imm]);
+      if (ins.op == Op::LoadConst) return shortestText(prog.constants[ins.imm]);
       const auto* names = namesOfLoad(ins.op, m);
       return std::to_string(ins.imm) + (names && ins.imm < names->size() ? std::string(" (").append((*names)[ins.imm]) + ")" : "");
     }

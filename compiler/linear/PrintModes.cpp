@@ -2,21 +2,15 @@
 // (JSON) or 10 significant digits (table).
 #include <fmt/format.h>
 
-#include <charconv>
 #include <cmath>
 #include <numbers>
 #include <ostream>
 
 #include "linear/Linearize.h"
+#include "qdot/number_text.hpp"
 
 namespace qdot::linear {
 namespace {
-
-std::string exact(double v) {
-  char buf[32];
-  auto res = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, res.ptr);
-}
 
 std::string list(const std::vector<double>& v, const char* separator) {
   std::string out;
@@ -50,7 +44,7 @@ void printModes(std::ostream& os, const SecondOrderSystem& s, const std::vector<
 void printModesJson(std::ostream& os, const SecondOrderSystem& s, const std::vector<Mode>& modes) {
   auto array = [](const std::vector<double>& v) {
     std::string out = "[";
-    for (size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + exact(v[i]);
+    for (size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + shortestText(v[i]);
     return out + "]";
   };
   os << "{\"coordinates\": [";
@@ -60,8 +54,8 @@ void printModesJson(std::ostream& os, const SecondOrderSystem& s, const std::vec
   for (size_t i = 0; i < modes.size(); ++i) {
     const Mode& m = modes[i];
     os << (i ? ", " : "") << "{\"oscillating\": " << (m.oscillating ? "true" : "false") << ", \"omega\": "
-       << exact(m.omega) << ", \"hz\": " << exact(m.omega / (2 * std::numbers::pi)) << ", \"zeta\": " << exact(m.zeta)
-       << ", \"rate\": " << exact(m.rate) << ", \"shape\": " << array(m.shape) << "}";
+       << shortestText(m.omega) << ", \"hz\": " << shortestText(m.omega / (2 * std::numbers::pi)) << ", \"zeta\": " << shortestText(m.zeta)
+       << ", \"rate\": " << shortestText(m.rate) << ", \"shape\": " << array(m.shape) << "}";
   }
   os << "]}\n";
 }

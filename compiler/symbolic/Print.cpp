@@ -2,12 +2,12 @@
 // (no recursion, output-linear time). Sums print as `a - 2*b + 1` (constant last), products as
 // `-a*b`, negative constant powers as division `a/(b*c)`, x^0.5 as `sqrt(x)`, selects as
 // `if c then a else b`. Term and factor order is the canonical (structural) order of the node.
-#include <charconv>
 #include <cmath>
 #include <deque>
 #include <string_view>
 
 #include "symbolic/ContextImpl.h"
+#include "qdot/number_text.hpp"
 
 namespace qdot::sym {
 
@@ -15,12 +15,6 @@ namespace {
 
 // Precedence levels, loosest first.
 enum Prec : int { IfExpr, OrP, AndP, NotP, Relation, Additive, Multiplicative, Power, Primary };
-
-std::string number(double v) {
-  char buf[64];
-  auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
 
 bool isNegativeConstant(Expr e) { return e->isConstant() && e->value < 0.0; }
 
@@ -88,7 +82,7 @@ class Printer {
 
  private:
   void text(std::string_view s) { seq_.push_back({s, nullptr, 0}); }
-  void numberText(double v) { text(numbers_.emplace_back(number(v))); }
+  void numberText(double v) { text(numbers_.emplace_back(shortestText(v))); }
   void node(Expr n, int minPrec) { seq_.push_back({{}, n, minPrec}); }
 
   // Schedules the pieces of n (in reading order) on the stack.

@@ -2,20 +2,14 @@
 // one per line with its word offset, and the source an instruction serves whenever it changes.
 // Driven by the opcode table, so a new opcode is printed without touching this file.
 #include <algorithm>
-#include <charconv>
 #include <cstdio>
 #include <ostream>
 
 #include "vm/Vm.h"
+#include "qdot/number_text.hpp"
 
 namespace qdot::vm {
 namespace {
-
-std::string num(double v) {
-  char buf[32];
-  auto res = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, res.ptr);
-}
 
 std::string reg(uint32_t r) { return std::string("r").append(std::to_string(r)); }
 
@@ -24,7 +18,7 @@ std::string indexName(const bc::Module& m, bc::Opcode op, uint32_t i, const bc::
   if (op == bc::Opcode::LoadY || op == bc::Opcode::LoadYp) names = &m.description.variableNames;
   if (op == bc::Opcode::LoadP || op == bc::Opcode::LoadGiven || op == bc::Opcode::LoadOverridden)
     names = &m.description.parameterNames;
-  if (op == bc::Opcode::LoadConst && i < f.constants.size()) return std::to_string(i) + std::string(" (").append(num(f.constants[i])) + ")";
+  if (op == bc::Opcode::LoadConst && i < f.constants.size()) return std::to_string(i) + std::string(" (").append(shortestText(f.constants[i])) + ")";
   return std::to_string(i) + (names && i < names->size() ? std::string(" (").append((*names)[i]) + ")" : "");
 }
 
@@ -59,7 +53,7 @@ void disassembleFunction(std::ostream& os, const bc::Module& m, ModelProgram pro
   os << "\nfunction " << programName(program) << ": " << f.registerCount << " registers ("
      << f.constants.size() << " constants), " << f.outputCount << " outputs, " << instructions << " instructions, "
      << f.code.size() << " words\n";
-  for (size_t k = 0; k < f.constants.size(); ++k) os << "  " << reg(k) << " = " << num(f.constants[k]) << "\n";
+  for (size_t k = 0; k < f.constants.size(); ++k) os << "  " << reg(k) << " = " << shortestText(f.constants[k]) << "\n";
   uint32_t source = bc::kNoSource - 1;
   size_t ordinal = 0;
   for (size_t pc = 0; pc < f.code.size() && f.code[pc] < bc::kOpcodeCount; ++ordinal) {

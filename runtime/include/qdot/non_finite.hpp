@@ -8,7 +8,6 @@
 // backend links the other (it runs only after a failure; speed does not matter).
 #pragma once
 
-#include <charconv>
 #include <cmath>
 #include <span>
 #include <string>
@@ -17,6 +16,7 @@
 
 #include "qdot/bytecode.h"
 #include "qdot/model_description.hpp"
+#include "qdot/number_text.hpp"
 #include "qdot/programs.hpp"
 
 namespace qdot {
@@ -34,12 +34,6 @@ namespace detail {
 
 inline constexpr uint32_t kFiniteOrigin = UINT32_MAX;        // origin of a finite value
 inline constexpr uint32_t kConstantOrigin = UINT32_MAX - 1;  // a non-finite constant of the pool
-
-inline std::string number(double v) {
-  char buf[32];
-  auto res = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, res.ptr);
-}
 
 // The value `ins` computes (a store: the value stored).
 inline double evaluate(const bc::Instruction& ins, const std::vector<double>& r, const ModelCall& in, const double* k) {
@@ -69,7 +63,7 @@ inline std::string nameAt(const std::vector<std::string>& names, uint32_t i) { r
 // Why `ins` produced a non-finite value from finite operands A, B (or from nothing, for loads).
 inline std::string describeProblem(const ModelDescription& d, const bc::Instruction& ins, double A, double B,
                                    double value) {
-  const std::string a = number(A), b = number(B), v = number(value);
+  const std::string a = shortestText(A), b = shortestText(B), v = shortestText(value);
   switch (ins.op) {
     case bc::Opcode::Sqrt: return "sqrt of a negative number (" + a + ")";
     case bc::Opcode::Log: return A == 0.0 ? "log of zero" : "log of a negative number (" + a + ")";
@@ -143,7 +137,7 @@ inline std::string diagnoseNonFinite(const ModelDescription& d, std::span<const 
     }
     if (!std::isfinite(value) && from == kFiniteOrigin) {
       from = i;
-      problems[i] = undefined ? "undefined value (" + number(value) + ")"
+      problems[i] = undefined ? "undefined value (" + shortestText(value) + ")"
                               : describeProblem(d, ins, r[ins.a], r[ins.b], value);
     }
     if (ins.op == bc::Opcode::Store) {
