@@ -137,6 +137,13 @@ Linearization linearize(const dae::Dae& d, sym::Context& ctx, const ModelValues&
                 "and time (an algebraic unknown), or are not finite at the operating point";
     return out;
   }
+  // T = ½ q̇ᵀ M q̇ must be positive for every motion: a zero or negative mass or inertia is the
+  // user's mistake, not a mode.
+  if (Eigen::LLT<Eigen::MatrixXd> llt(0.5 * (s.M + s.M.transpose())); llt.info() != Eigen::Success) {
+    out.error = "the mass matrix is not positive definite at the operating point: check the masses and inertias "
+                "(the kinetic energy must be positive for every motion)";
+    return out;
+  }
   for (size_t j = 0; j < n; ++j) s.coordinates.push_back(d.variables[cs[j].qVar].name);
   s.point.assign(q.data(), q.data() + n);
   s.time = values.time;

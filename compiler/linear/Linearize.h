@@ -43,8 +43,8 @@ struct Linearization {
 };
 
 /// Linearizes the Euler–Lagrange rows of `dae` (the first dae.coordinates.size() equations). Models
-/// with constraints, algebraic unknowns in those rows or coordinates without inertia are refused
-/// with a reason. `ctx` is the Context of the DAE's expressions.
+/// with constraints, algebraic unknowns in those rows, coordinates without inertia or a mass matrix
+/// that is not positive definite are refused with a reason. `ctx` is the Context of the DAE's expressions.
 Linearization linearize(const dae::Dae& dae, sym::Context& ctx, const ModelValues& values, OperatingPoint at);
 
 /// One mode. Oscillatory: ω = |λ|, ζ = −Re λ / |λ|; a real eigenvalue λ (overdamped, rigid-body or

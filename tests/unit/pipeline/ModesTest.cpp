@@ -109,6 +109,11 @@ TEST(Modes, NoEquilibriumAndBadParametersAreReported) {
   ModesResult wedge = modesOf("textbook/wedge.qd");
   EXPECT_EQ(wedge.code, ExitCode::ModelError);
   EXPECT_NE(wedge.error.find("no isolated static equilibrium"), std::string::npos) << wedge.error;
+  for (const char* mass : {"m=0", "m=-1"}) {  // no kinetic energy, or a negative one
+    ModesResult massless = modesOf("vibration/two_mass_modes.qd", {mass});
+    EXPECT_EQ(massless.code, ExitCode::ModelError) << mass;
+    EXPECT_NE(massless.error.find("mass matrix is not positive definite"), std::string::npos) << massless.error;
+  }
   ModesResult bad = modesOf("vibration/two_mass_modes.qd", {"mm=3"});
   EXPECT_EQ(bad.code, ExitCode::Usage);
   EXPECT_NE(bad.error.find("did you mean 'm'"), std::string::npos) << bad.error;
