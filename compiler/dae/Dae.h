@@ -44,6 +44,7 @@ struct Parameter {
   sym::Expr value = nullptr;  ///< default, over other parameters
   std::string description, unit;
   SourceRange declRange;
+  bool input = false;  ///< an `input` of the model (a parameter whose default is 0)
 };
 
 /// A quantity conserved along solutions (first integral) or otherwise worth monitoring.

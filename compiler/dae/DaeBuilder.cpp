@@ -65,7 +65,8 @@ class Builder {
     for (const auto& f : m_.variables)
       if (f.role == flat::VarRole::Parameter)
         dae_.parameters.push_back(
-            {std::string(f.name), f.symbol, f.value, std::string(f.description), std::string(f.unit), f.declRange});
+            {std::string(f.name), f.symbol, f.value, std::string(f.description), std::string(f.unit), f.declRange,
+             f.input});
   }
 
   // Coordinates first, then velocities (spec §5). A coordinate whose row contains no velocity at

@@ -234,6 +234,16 @@ Value Flattener::createDeclaration(const Declaration& d, const sema::ModelSymbol
       for (size_t i = 0; i < vars.size(); ++i) out_.variables[out_.variableOf(vars.elems[i])].value = values.elems[i];
       return vars;
     }
+    case SymbolKind::Input: {  // of the model compiled: a run-time input, 0 unless set (-p u=1)
+      Value vars = variablesFor(d, shape, VarRole::Parameter);
+      for (Expr x : vars.elems) {
+        Variable& var = out_.variables[out_.variableOf(x)];
+        var.value = ctx_.zero();
+        var.input = true;
+      }
+      applyAttributes(d, vars);
+      return vars;
+    }
     case SymbolKind::Coordinate:
     case SymbolKind::Unknown: {
       bool coord = s.kind == SymbolKind::Coordinate;

@@ -64,6 +64,9 @@ class Checker {
     std::string t = typeNameOf(d);
     s.type = t == "Integer" ? BaseType::Integer : t == "Boolean" ? BaseType::Boolean : BaseType::Real;
     if (d.variability == Variability::Constant) s.kind = SymbolKind::Constant;
+    else if (d.causality == Causality::Input && !d.binding && d.variability == Variability::Continuous &&
+             s.type == BaseType::Real && !d.isCoordinate)
+      s.kind = SymbolKind::Input;
     else if (d.variability == Variability::Parameter)
       s.kind = s.type == BaseType::Integer ? SymbolKind::IntegerParameter : SymbolKind::Parameter;
     else if (d.isCoordinate) s.kind = SymbolKind::Coordinate;
@@ -95,9 +98,9 @@ class Checker {
     if (d.isFlow)
       diags_.error(d.range, DiagCode::E0290, "'flow' variables are not supported yet",
                    "declare a plain Real and write the balance equation yourself, e.g. i1 + i2 = 0;");
-    if (d.causality == Causality::Input)
-      diags_.error(d.range, DiagCode::E0290, "'input' variables are not supported yet",
-                   "use a parameter, or a definition in terms of time: Real u = sin(time);");
+    if (d.causality == Causality::Input && d.isCoordinate)
+      diags_.error(d.range, DiagCode::E0206, "a coordinate cannot be an input",
+                   "remove 'input', or declare a plain 'input Real' and use it in a force");
     if (d.isCoordinate && s.type != BaseType::Real)
       diags_.error(d.typeRange, DiagCode::E0205, "coordinate '" + d.name + "' must be of type Real",
                    "declare it as: coordinate Real " + d.name + ";");

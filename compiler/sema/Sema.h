@@ -23,6 +23,8 @@ enum class SymbolKind {
   Coordinate,        ///< `coordinate Real`: a generalized coordinate
   Unknown,           ///< `Real x;` without binding (state or algebraic)
   Definition,        ///< `Real y = expr;` (also `output Real y = expr;`): substituted
+  Input,             ///< `input Real u;` without binding: of the model compiled, a run-time input
+                     ///< (a parameter whose default is 0, the B columns of `qdot linearize`)
 };
 
 enum class BaseType { Real, Integer, Boolean };
