@@ -54,6 +54,7 @@ class Builder {
   Dae dae_;
   std::vector<Equation> kinematic_;
   std::unordered_map<Expr, Expr> aliases_;  ///< symbol of a variable that is not an unknown → its value
+  uint64_t aliasMask_ = 0;
   std::vector<char> appears_;               ///< by symbol id: in some equation (after substitution)
 
   // Connected potentials and their derivatives are one variable (FlatModel: Variable::alias).
@@ -61,15 +62,16 @@ class Builder {
     for (const auto& v : m_.variables)
       if (v.alias) aliases_.emplace(v.symbol, v.alias);
     // An alias of an alias (a value that is itself eliminated) resolves to the end of the chain.
+    aliasMask_ = sym::Context::keyMaskOf(aliases_);
     for (auto& [from, to] : aliases_)
-      for (int guard = 0; guard < 8 && (to->symbolMask != 0); ++guard) {
-        Expr next = ctx_.substitute(to, aliases_);
+      for (int guard = 0; guard < 8; ++guard) {
+        Expr next = ctx_.substitute(to, aliases_, aliasMask_);
         if (next == to) break;
         to = next;
       }
   }
 
-  Expr substituted(Expr e) { return aliases_.empty() || !e ? e : ctx_.substitute(e, aliases_); }
+  Expr substituted(Expr e) { return aliases_.empty() || !e ? e : ctx_.substitute(e, aliases_, aliasMask_); }
 
   // Which symbols the equations contain: decides what kind of unknown each coordinate is.
   void markAppearances() {

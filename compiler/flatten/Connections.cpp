@@ -131,7 +131,7 @@ void Flattener::addFlowBalances(const std::vector<std::vector<ConnectorEnd>>& se
     for (const Declaration* d : cls.declarations) {
       if (!d->isFlow) continue;
       std::vector<Value> flows;
-      for (const ConnectorEnd& e : sets[s]) flows.push_back(valueOf(*e.connector, *e.connector->cls->find(d->name)->decl, ranges[s]));
+      for (const ConnectorEnd& e : sets[s]) flows.push_back(valueOf(*e.connector, *e.connector->cls->find(d->name), ranges[s]));
       for (size_t j = 0; j < flows.front().size(); ++j) {
         std::vector<Expr> terms;
         for (size_t k = 0; k < flows.size(); ++k)
@@ -155,7 +155,7 @@ void Flattener::eliminateAliases(const std::vector<std::vector<ConnectorEnd>>& s
     for (const Declaration* d : cls.declarations) {
       if (d->isFlow || cls.symbols.at(d->name).kind == sema::SymbolKind::Component) continue;
       std::vector<Value> values;
-      for (const ConnectorEnd& e : sets[s]) values.push_back(valueOf(*e.connector, *e.connector->cls->find(d->name)->decl, ranges[s]));
+      for (const ConnectorEnd& e : sets[s]) values.push_back(valueOf(*e.connector, *e.connector->cls->find(d->name), ranges[s]));
       for (size_t k = 1; k < values.size(); ++k)
         for (size_t j = 0; j < values[k].size(); ++j) {
           uf.unite(out_.variableOf(values[0].elems[j]), out_.variableOf(values[k].elems[j]));
@@ -268,8 +268,8 @@ void Flattener::attachFlows() {
         std::vector<const Declaration*> potentials, flows;
         for (const Declaration* f : c->cls->declarations) (f->isFlow ? flows : potentials).push_back(f);
         for (size_t k = 0; k < potentials.size() && k < flows.size(); ++k) {
-          const Value& p = valueOf(*c, *potentials[k], d->nameRange);
-          const Value& f = valueOf(*c, *flows[k], d->nameRange);
+          const Value& p = valueOf(*c, c->cls->symbols.at(potentials[k]->name), d->nameRange);
+          const Value& f = valueOf(*c, c->cls->symbols.at(flows[k]->name), d->nameRange);
           for (size_t j = 0; j < p.size() && j < f.size(); ++j) {
             int target = coordinateOfPotential(inst, out_.variableOf(p.elems[j]));
             if (target >= 0) out_.forces.push_back({target, {f.elems[j], d->nameRange}});

@@ -82,7 +82,7 @@ Value Flattener::lowerName(const NameExpr& n) {
     if (it->first == name) return Value::scalar(it->second);
   if (const sema::ModelSymbol* s = cur_->cls->find(name)) {
     if (s->kind == sema::SymbolKind::Component) fail(n.range, DiagCode::E0224, "'" + name + "' is a component, not a value");
-    return valueOf(*cur_, *s->decl, n.range);
+    return valueOf(*cur_, *s, n.range);
   }
   if (name == "time") return Value::scalar(out_.time());
   if (name == "pi") return Value::scalar(ctx_.constant(std::numbers::pi));
@@ -139,7 +139,7 @@ const Value& Flattener::subscriptBase(const ast::Expr& e, Value& holder) {
     bool isIterator = false;
     for (const auto& it : iterators_) isIterator |= it.first == n->parts[0];
     const sema::ModelSymbol* s = cur_->cls->find(n->parts[0]);
-    if (!isIterator && s && s->kind != sema::SymbolKind::Component) return valueOf(*cur_, *s->decl, n->range);
+    if (!isIterator && s && s->kind != sema::SymbolKind::Component) return valueOf(*cur_, *s, n->range);
   }
   holder = lower(e);
   return holder;

@@ -105,7 +105,7 @@ void Flattener::declareInstance(Instance& inst) {
   cur_ = &inst;
   for (const auto* d : inst.cls->declarations)
     if (inst.cls->symbols.at(d->name).kind != sema::SymbolKind::Component)
-      guarded([&] { valueOf(inst, *d, d->nameRange); });
+      guarded([&] { valueOf(inst, inst.cls->symbols.at(d->name), d->nameRange); });
 }
 
 void Flattener::lowerInstance(Instance& inst) {
@@ -167,18 +167,19 @@ int Flattener::derivativeVariable(int var, SourceRange where) {
 // with the side effects in the order) that the recursion had. A use of a pending declaration
 // closes a cycle. (The price: a binding naming k declarations not yet resolved is lowered k + 1
 // times, so a literal array of 10⁴ forward references takes seconds; models name a few.)
-const Value& Flattener::valueOf(Instance& inst, const Declaration& d, SourceRange use) {
-  DeclKey key{&inst, &d};
-  if (auto it = declValues_.find(key); it != declValues_.end()) return it->second;
-  if (failed_.count(key)) throw FlattenAbort{};
-  if (inProgress_.count(key))
-    fail(use, DiagCode::E0312, "the definition of '" + inst.prefix() + d.name + "' depends on itself",
+const Value& Flattener::valueOf(Instance& inst, const sema::ModelSymbol& s, SourceRange use) {
+  DeclKey key{&inst, &s};
+  Instance::Slot& slot = key.slot();
+  if (slot.state == Instance::Slot::Resolved) return slot.value;
+  if (slot.state == Instance::Slot::Failed) throw FlattenAbort{};
+  if (slot.state == Instance::Slot::Pending)
+    fail(use, DiagCode::E0312, "the definition of '" + inst.prefix() + s.decl->name + "' depends on itself",
          "break the cycle: a definition or parameter cannot refer to itself, directly or through others");
   if (!pending_.empty()) throw NeedFirst{key};
   pending_.push_back(key);
-  inProgress_.insert(key);
+  slot.state = Instance::Slot::Pending;
   while (!pending_.empty()) resolveInnermost();
-  return declValues_.at(key);
+  return slot.value;
 }
 
 void Flattener::resolveInnermost() {
@@ -186,18 +187,18 @@ void Flattener::resolveInnermost() {
   size_t scalarsBefore = scalars_;  // the retry counts this declaration's scalars again
   try {
     ScopeGuard scope(*this, *key.inst);
-    Value v = createDeclaration(*key.decl, key.inst->cls->symbols.at(key.decl->name));
-    declValues_.emplace(key, std::move(v));
-    inProgress_.erase(key);
+    creating_ = key.symbol;
+    Value v = createDeclaration(*key.symbol->decl, *key.symbol);
+    key.slot().value = std::move(v);
+    key.slot().state = Instance::Slot::Resolved;
     pending_.pop_back();
   } catch (const NeedFirst& first) {
     scalars_ = scalarsBefore;
     pending_.push_back(first.key);
-    inProgress_.insert(first.key);
+    first.key.slot().state = Instance::Slot::Pending;
   } catch (...) {  // an error: every declaration waiting for this one fails with it
-    failed_.insert(pending_.begin(), pending_.end());
+    for (const DeclKey& k : pending_) k.slot().state = Instance::Slot::Failed;
     pending_.clear();
-    inProgress_.clear();
     throw;
   }
 }
@@ -310,8 +311,8 @@ void Flattener::reserveVariables(size_t count) {
 
 // Once per declaration: lowering it again after a dependency was resolved finds them here.
 Value Flattener::variablesFor(const Declaration& d, const std::vector<int>& shape, VarRole role) {
-  DeclKey key{cur_, &d};
-  if (auto it = declVariables_.find(key); it != declVariables_.end()) return it->second;
+  Instance::Slot& slot = cur_->slots[creating_->index];
+  if (slot.hasVariables) return slot.variables;
   Value v{shape, {}};
   std::vector<std::string> names = scalarNames(cur_->prefix() + d.name, shape);
   // a coordinate brings its velocity and acceleration
@@ -322,7 +323,9 @@ Value Flattener::variablesFor(const Declaration& d, const std::vector<int>& shap
     addVariable({.role = role, .symbol = symbol, .declRange = d.nameRange, .description = d.description});
     v.elems.push_back(symbol);
   }
-  return declVariables_.emplace(key, std::move(v)).first->second;
+  slot.variables = std::move(v);
+  slot.hasVariables = true;
+  return slot.variables;
 }
 
 void Flattener::checkShape(const Value& v, const std::vector<int>& shape, SourceRange r, const std::string& what) {

@@ -115,6 +115,13 @@ struct Instance {
   std::vector<std::string> promoted;       ///< a connector's potentials that are coordinates
   std::unordered_map<const ast::Declaration*, ComponentArray> children;
   std::vector<std::pair<int, int>> aliasPairs;  ///< its equations `x = y` between variables
+  /// By declaration (sema::ModelSymbol::index): its value once resolved, its variables once made.
+  struct Slot {
+    Value value, variables;
+    enum : uint8_t { Empty, Pending, Resolved, Failed } state = Empty;
+    bool hasVariables = false;
+  };
+  std::vector<Slot> slots;
 
   std::string prefix() const { return path.empty() ? "" : path + "."; }
 };
@@ -122,13 +129,8 @@ struct Instance {
 /// A declaration of one instance: what the work list of definitions resolves.
 struct DeclKey {
   Instance* inst = nullptr;
-  const ast::Declaration* decl = nullptr;
-  bool operator==(const DeclKey& o) const { return inst == o.inst && decl == o.decl; }
-};
-struct DeclKeyHash {
-  size_t operator()(const DeclKey& k) const {
-    return std::hash<const void*>()(k.inst) * 31 + std::hash<const void*>()(k.decl);
-  }
+  const sema::ModelSymbol* symbol = nullptr;
+  Instance::Slot& slot() const { return inst->slots[symbol->index]; }
 };
 
 /// Thrown while lowering a declaration that uses `key`, not yet resolved: resolve that one first.
@@ -178,11 +180,8 @@ class Flattener {
 
   std::deque<Instance> instances_;  ///< [0] is the model; then components in creation order
   Instance* cur_ = nullptr;         ///< whose names the expressions being lowered use
-  std::unordered_map<DeclKey, Value, DeclKeyHash> declValues_;
-  std::unordered_map<DeclKey, Value, DeclKeyHash> declVariables_;  ///< a declaration's variables, made once
-  std::vector<DeclKey> pending_;  ///< declarations waiting for one another, innermost last
-  std::unordered_set<DeclKey, DeclKeyHash> inProgress_;  ///< the same, to find a cycle quickly
-  std::unordered_set<DeclKey, DeclKeyHash> failed_;  ///< already reported; later uses abort quietly
+  std::vector<DeclKey> pending_;  ///< declarations waiting for one another, innermost last (Slot::Pending)
+  const sema::ModelSymbol* creating_ = nullptr;  ///< the declaration createDeclaration is making
   std::map<std::pair<const ast::Modification*, Instance*>, Value> modValues_;  ///< each modifier lowered once
   std::map<std::pair<const ast::Modification*, const Instance*>, ModEntry> extendsEntries_;
   std::vector<Instance*> varOwner_;       ///< by variable: the instance that declared it
@@ -193,7 +192,7 @@ class Flattener {
   std::vector<std::pair<const Value*, int>> endContext_;      ///< (array, dimension) being subscripted, for `end`
 
   // Flatten.cpp
-  const Value& valueOf(Instance& inst, const ast::Declaration& d, SourceRange use);
+  const Value& valueOf(Instance& inst, const sema::ModelSymbol& s, SourceRange use);
   void resolveInnermost();
   Value createDeclaration(const ast::Declaration& d, const sema::ModelSymbol& s);
   std::vector<int> evaluateDims(const ast::Declaration& d);

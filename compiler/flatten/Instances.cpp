@@ -18,6 +18,7 @@ Instance& Flattener::newInstance(const sema::CheckedClass& cls, Instance* parent
   inst.decl = decl;
   inst.path = std::move(path);
   inst.index = static_cast<int>(out_.components.size());
+  inst.slots.resize(cls.declarations.size());
   out_.components.push_back(inst.path);
   return inst;
 }
@@ -159,7 +160,7 @@ Value Flattener::lowerDotted(const NameExpr& n) {
   const sema::ModelSymbol& s = symbolIn(*inst, n.parts.back(), n.range);
   if (s.kind == SymbolKind::Component)
     fail(n.range, DiagCode::E0224, "'" + n.dotted() + "' is a component, not a value");
-  return valueOf(*inst, *s.decl, n.range);
+  return valueOf(*inst, s, n.range);
 }
 
 // `ms[i].s`, `ms[i].a.s`.
@@ -167,7 +168,7 @@ Value Flattener::lowerMember(const MemberExpr& e) {
   Instance& inst = instanceOf(*e.base);
   const sema::ModelSymbol& s = symbolIn(inst, e.field, e.fieldRange);
   if (s.kind == SymbolKind::Component) fail(e.range, DiagCode::E0224, "this is a component, not a value");
-  return valueOf(inst, *s.decl, e.range);
+  return valueOf(inst, s, e.range);
 }
 
 }  // namespace qdot::flat

@@ -151,7 +151,8 @@ class ClassChecker {
 
   // --- declarations ----------------------------------------------------------------------------
 
-  bool addSymbol(const Declaration& d, const ModelSymbol& s) {
+  bool addSymbol(const Declaration& d, ModelSymbol s) {
+    s.index = static_cast<int>(c_.declarations.size());
     auto [it, inserted] = c_.symbols.try_emplace(d.name, s);
     if (!inserted) {
       auto& diag = diags_.error(d.nameRange, DiagCode::E0201, "'" + d.name + "' is declared twice",

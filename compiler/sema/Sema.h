@@ -42,6 +42,7 @@ struct ModelSymbol {
   SymbolKind kind = SymbolKind::Unknown;
   BaseType type = BaseType::Real;
   const CheckedClass* component = nullptr;  ///< Component: its class (null if it did not resolve)
+  int index = -1;  ///< the declaration's position in its class's CheckedClass::declarations
 };
 
 /// One class as instances see it: its own elements and those it inherits (`extends`), with every

@@ -121,6 +121,10 @@ class Context {
   /// Replaces symbols by expressions (all at once, not recursively) and re-simplifies.
   /// A key may also be any other node, which is then replaced wherever it occurs as a node.
   Expr substitute(Expr e, const std::unordered_map<Expr, Expr>& map);
+  /// The same with the keys' symbol mask given (keyMaskOf(map)): substituting one map into many
+  /// expressions then costs nothing per key.
+  Expr substitute(Expr e, const std::unordered_map<Expr, Expr>& map, uint64_t keyMask);
+  static uint64_t keyMaskOf(const std::unordered_map<Expr, Expr>& map);
 
   /// True if symbol s occurs in e (exact; uses the mask to answer "no" fast).
   bool dependsOn(Expr e, Expr s) const;

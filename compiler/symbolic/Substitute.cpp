@@ -5,10 +5,18 @@
 
 namespace qdot::sym {
 
-Expr Context::substitute(Expr e, const std::unordered_map<Expr, Expr>& map) {
-  if (map.empty()) return e;
+uint64_t Context::keyMaskOf(const std::unordered_map<Expr, Expr>& map) {
   uint64_t keyMask = 0;
   for (auto& [from, to] : map) keyMask |= from->symbolMask;
+  return keyMask;
+}
+
+Expr Context::substitute(Expr e, const std::unordered_map<Expr, Expr>& map) {
+  return substitute(e, map, keyMaskOf(map));
+}
+
+Expr Context::substitute(Expr e, const std::unordered_map<Expr, Expr>& map, uint64_t keyMask) {
+  if (map.empty() || !(e->symbolMask & keyMask)) return e;
   auto enter = [&](Expr n) { return (n->symbolMask & keyMask) && !map.count(n); };
   PostOrder po = postOrder(std::span<const Expr>(&e, 1), enter);
 
