@@ -20,7 +20,7 @@ std::string list(const std::vector<double>& v, const char* separator) {
 
 }  // namespace
 
-void printModes(std::ostream& os, const SecondOrderSystem& s, const std::vector<Mode>& modes) {
+void printModes(std::ostream& os, const LinearModel& s, const std::vector<Mode>& modes) {
   std::string names;
   for (const auto& c : s.coordinates) names += (names.empty() ? "" : ", ") + c;
   os << "operating point: " << names << " = " << list(s.point, ", ");
@@ -41,7 +41,7 @@ void printModes(std::ostream& os, const SecondOrderSystem& s, const std::vector<
   }
 }
 
-void printModesJson(std::ostream& os, const SecondOrderSystem& s, const std::vector<Mode>& modes) {
+void printModesJson(std::ostream& os, const LinearModel& s, const std::vector<Mode>& modes) {
   auto array = [](const std::vector<double>& v) {
     std::string out = "[";
     for (size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + shortestText(v[i]);
