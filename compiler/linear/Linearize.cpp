@@ -198,9 +198,9 @@ std::string indexReason(const dae::Dae& d, const Eigen::FullPivLU<MatrixXd>& lu)
       }
   }
   return "the DAE is not of index 1 at the operating point: its equations do not determine the state derivatives "
-         "and algebraic unknowns from the states" + (names.empty() ? "" : " (" + names + " are left free)") +
-         "; there is no state-space form without index reduction (e.g. a constraint between coordinates, or an "
-         "algebraic unknown that no equation determines)";
+         "and algebraic unknowns from the states" + (names.empty() ? "" : " (not determined: " + names + ")") +
+         ", so it has no state-space form without index reduction (a constraint between coordinates, or an "
+         "algebraic unknown whose equations vanish there, such as a force through a lever of length zero)";
 }
 
 // ẋ = A x + B u, y = C x + D u from the Jacobians at the point, with P = [∂F/∂x' ∂F/∂z] invertible:

@@ -34,7 +34,7 @@ void printModes(std::ostream& os, const LinearModel& s, const std::vector<Mode>&
     const Mode& m = modes[i];
     if (m.oscillating)
       os << fmt::format("{:>4}  {:>16.10g}  {:>16.10g}  {:>12.6g}  {}\n", i + 1, m.omega,
-                        m.omega / (2 * std::numbers::pi), m.zeta, list(m.shape, ", "));
+                        m.omega / (2 * std::numbers::pi), m.zeta == 0 ? 0.0 : m.zeta, list(m.shape, ", "));
     else
       os << fmt::format("{:>4}  {:>16}  {:>16}  {:>12}  {}   (not oscillating: e^({:.10g} t))\n", i + 1, "-", "-",
                         "-", list(m.shape, ", "), m.rate);

@@ -1,0 +1,214 @@
+// qdot linearize and qdot modes on DAEs with algebraic unknowns (driver/Modes.h, compiler/linear),
+// against closed forms to 1e-8 relative:
+//   a force given by an equation, F = −k x − c ẋ: ω = √(k/m), ζ = c / (2√(km)); output F: C = [−k, −c];
+//   a massless node x2 between springs k1 (to the mass) and k2 (to the wall): ω² = k1 k2 / ((k1 + k2) m);
+//   a spring acting through a lever, r F = −k x: ω² = k / (r m); with r = 0 nothing determines F
+//   (index > 1: refused);
+//   a forced mass–spring–damper, input u: A = [[0, 1], [−k/m, −c/m]], B = [[0], [1/m]];
+//   the same mass driven through a first-order lag τ ḟ = u − f (not a mechanical system: the modes
+//   are the eigenvalues of A): ω = √(k/m) and the real rate −1/τ.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "driver/Modes.h"
+
+namespace qdot::driver {
+namespace {
+
+constexpr const char* algebraicForce = R"(
+model AlgebraicForce
+  parameter Real m = 2, k = 50, c = 3;
+  coordinate Real x(start = 0.1);
+  Real F;
+  output Real Fo = F;
+mechanics
+  kinetic = 0.5*m*der(x)^2;
+  force(x) = F;
+equation
+  F = -k*x - c*der(x);
+end AlgebraicForce;
+)";
+
+constexpr const char* masslessNode = R"(
+model MasslessNode
+  parameter Real m = 2, k1 = 30, k2 = 60;
+  coordinate Real x1(start = 0.1), x2;
+mechanics
+  kinetic = 0.5*m*der(x1)^2;
+  potential = 0.5*k1*(x1 - x2)^2 + 0.5*k2*x2^2;
+end MasslessNode;
+)";
+
+constexpr const char* lever = R"(
+model Lever
+  parameter Real m = 1.5, k = 10, r = 0.5;
+  coordinate Real x(start = 0.1);
+  Real F;
+mechanics
+  kinetic = 0.5*m*der(x)^2;
+  force(x) = F;
+equation
+  r*F = -k*x;
+end Lever;
+)";
+
+constexpr const char* forced = R"(
+model ForcedMSD
+  parameter Real m = 2, k = 50, c = 3;
+  input Real u;
+  coordinate Real x(start = 0);
+mechanics
+  kinetic = 0.5*m*der(x)^2;
+  potential = 0.5*k*x^2;
+  dissipation = 0.5*c*der(x)^2;
+  force(x) = u;
+end ForcedMSD;
+)";
+
+constexpr const char* lag = R"(
+model Lag
+  parameter Real m = 2, k = 50, tau = 0.25;
+  input Real u;
+  coordinate Real x(start = 0);
+  Real f(start = 0);
+mechanics
+  kinetic = 0.5*m*der(x)^2;
+  potential = 0.5*k*x^2;
+  force(x) = f;
+equation
+  tau*der(f) = u - f;
+end Lag;
+)";
+
+// Compiles `source` and linearizes it with the run-time values `parameters`.
+template <class Result, class Compute>
+Result compiled(const char* source, const std::vector<std::string>& parameters, linear::OperatingPoint at, Compute compute) {
+  Compilation c;
+  EXPECT_TRUE(compileSource(c, "test.qd", source, "", Stage::Kernel));
+  return compute(c, parameters, at);
+}
+
+LinearizeResult linearized(const char* source, std::vector<std::string> parameters = {},
+                           linear::OperatingPoint at = linear::OperatingPoint::Equilibrium) {
+  return compiled<LinearizeResult>(source, parameters, at, linearizeModel);
+}
+
+ModesResult modesOf(const char* source, std::vector<std::string> parameters = {},
+                    linear::OperatingPoint at = linear::OperatingPoint::Equilibrium) {
+  return compiled<ModesResult>(source, parameters, at, computeModes);
+}
+
+void expectRelative(double got, double want, double rel = 1e-8) { EXPECT_NEAR(got, want, rel * std::fabs(want)); }
+
+void expectMatrix(const Eigen::MatrixXd& got, const Eigen::MatrixXd& want) {
+  ASSERT_EQ(got.rows(), want.rows());
+  ASSERT_EQ(got.cols(), want.cols());
+  for (Eigen::Index i = 0; i < want.rows(); ++i)
+    for (Eigen::Index j = 0; j < want.cols(); ++j)
+      EXPECT_NEAR(got(i, j), want(i, j), 1e-12 * std::max(1.0, std::fabs(want(i, j)))) << "(" << i << ", " << j << ")";
+}
+
+TEST(Linearize, ForceFromAnEquationGivesTheOscillatorsModes) {
+  for (auto at : {linear::OperatingPoint::Equilibrium, linear::OperatingPoint::Start}) {
+    ModesResult r = modesOf(algebraicForce, {"m=2", "k=50", "c=3"}, at);
+    ASSERT_EQ(r.error, "");
+    ASSERT_EQ(r.modes.size(), 1u);
+    expectRelative(r.modes[0].omega, std::sqrt(50.0 / 2));
+    expectRelative(r.modes[0].zeta, 3 / (2 * std::sqrt(50.0 * 2)));
+    ASSERT_TRUE(r.system.mechanical);  // F eliminated from the row m ẍ − F = 0
+    expectRelative(r.system.mechanical->M(0, 0), 2);
+    expectRelative(r.system.mechanical->C(0, 0), 3);
+    expectRelative(r.system.mechanical->K(0, 0), 50);
+    EXPECT_EQ(r.system.coordinates, std::vector<std::string>{"x"});
+  }
+}
+
+TEST(Linearize, OutputThroughAnAlgebraicUnknown) {
+  LinearizeResult r = linearized(algebraicForce, {"k=40", "c=5"});
+  ASSERT_EQ(r.error, "");
+  const linear::StateSpace& s = r.model.stateSpace;
+  EXPECT_EQ(s.states, (std::vector<std::string>{"x", "der(x)"}));
+  EXPECT_EQ(s.outputs, std::vector<std::string>{"Fo"});
+  expectMatrix(s.C, Eigen::RowVector2d(-40, -5));
+  EXPECT_EQ(s.D.rows(), 1);
+  EXPECT_EQ(s.D.cols(), 0);
+}
+
+TEST(Linearize, MasslessNodeBetweenTwoSprings) {
+  ModesResult r = modesOf(masslessNode, {"m=2", "k1=30", "k2=60"});
+  ASSERT_EQ(r.error, "");
+  ASSERT_EQ(r.modes.size(), 1u);
+  expectRelative(r.modes[0].omega, std::sqrt(30.0 * 60 / (90 * 2)));
+  EXPECT_EQ(r.system.coordinates, std::vector<std::string>{"x1"});  // x2 is algebraic: not a state
+  ASSERT_TRUE(r.system.mechanical);
+  expectRelative(r.system.mechanical->K(0, 0), 30.0 * 60 / 90);
+}
+
+TEST(Linearize, ForcedMassSpringDamperStateSpace) {
+  double m = 2, k = 50, c = 3;
+  LinearizeResult r = linearized(forced, {"m=2", "k=50", "c=3"});
+  ASSERT_EQ(r.error, "");
+  const linear::StateSpace& s = r.model.stateSpace;
+  EXPECT_EQ(s.states, (std::vector<std::string>{"x", "der(x)"}));
+  EXPECT_EQ(s.inputs, std::vector<std::string>{"u"});
+  expectMatrix(s.A, (Eigen::Matrix2d() << 0, 1, -k / m, -c / m).finished());
+  expectMatrix(s.B, Eigen::Vector2d(0, 1 / m));
+  // A constant input moves the equilibrium to u/k; the matrices stay.
+  LinearizeResult pushed = linearized(forced, {"m=2", "k=50", "c=3", "u=5"});
+  ASSERT_EQ(pushed.error, "");
+  expectRelative(pushed.model.point[0], 5 / k, 1e-12);
+  expectMatrix(pushed.model.stateSpace.A, s.A);
+}
+
+TEST(Linearize, FirstOrderLagUsesTheStateSpaceEigenvalues) {
+  double m = 2, k = 50, tau = 0.25;
+  ModesResult r = modesOf(lag, {"m=2", "k=50", "tau=0.25"});
+  ASSERT_EQ(r.error, "");
+  EXPECT_FALSE(r.system.mechanical);  // f is a first-order state
+  expectMatrix(r.system.stateSpace.B, Eigen::Vector3d(0, 0, 1 / tau));
+  ASSERT_EQ(r.modes.size(), 2u);
+  expectRelative(r.modes[0].omega, std::sqrt(k / m));
+  EXPECT_NEAR(r.modes[0].zeta, 0, 1e-12);
+  EXPECT_FALSE(r.modes[1].oscillating);
+  expectRelative(r.modes[1].rate, -1 / tau);
+}
+
+TEST(Linearize, LeverAndItsIndexTwoLimit) {
+  ModesResult r = modesOf(lever, {"m=1.5", "k=10", "r=0.5"});
+  ASSERT_EQ(r.error, "");
+  ASSERT_EQ(r.modes.size(), 1u);
+  expectRelative(r.modes[0].omega, std::sqrt(10 / (0.5 * 1.5)));
+  for (auto at : {linear::OperatingPoint::Equilibrium, linear::OperatingPoint::Start}) {
+    LinearizeResult singular = linearized(lever, {"r=0"}, at);
+    EXPECT_EQ(singular.code, ExitCode::ModelError);
+    EXPECT_NE(singular.error.find("not of index 1"), std::string::npos) << singular.error;
+    EXPECT_NE(singular.error.find("not determined: der(der(x)), F"), std::string::npos) << singular.error;
+  }
+}
+
+TEST(Linearize, FlatModelsKeepTheirMassDampingAndStiffness) {
+  // The flat damped oscillator: the state-space A is [[0, 1], [−k/m, −c/m]] and M, C, K its rows'.
+  Compilation c;
+  ASSERT_TRUE(compileSource(c, "damped", R"(
+model Damped
+  parameter Real m = 4, k = 400, c = 6;
+  coordinate Real x(start = 0.1);
+mechanics
+  kinetic = 0.5*m*der(x)^2;
+  potential = 0.5*k*x^2;
+  dissipation = 0.5*c*der(x)^2;
+end Damped;
+)", "", Stage::Kernel));
+  LinearizeResult r = linearizeModel(c, {}, linear::OperatingPoint::Equilibrium);
+  ASSERT_EQ(r.error, "");
+  expectMatrix(r.model.stateSpace.A, (Eigen::Matrix2d() << 0, 1, -100, -1.5).finished());
+  EXPECT_EQ(r.model.stateSpace.B.cols(), 0);
+  ASSERT_TRUE(r.model.mechanical);
+  EXPECT_EQ(r.model.mechanical->M(0, 0), 4);
+  EXPECT_EQ(r.model.mechanical->C(0, 0), 6);
+  EXPECT_EQ(r.model.mechanical->K(0, 0), 400);
+}
+
+}  // namespace
+}  // namespace qdot::driver
