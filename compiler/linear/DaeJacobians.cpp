@@ -24,7 +24,10 @@ const std::vector<double>& PointValues::symbols() {
 }
 
 DaeJacobians::DaeJacobians(const dae::Dae& d, sym::Context& ctx, const std::vector<int>& inputs)
-    : equations_(d.equations.size()), outputs_(d.outputs.size()), variables_(d.variables.size()), inputs_(inputs.size()) {
+    : equations_(d.equations.size()),
+      outputs_(d.outputs.size()),
+      variables_(d.variables.size()),
+      inputs_(inputs.size()) {
   // Column c: y of variable c (c < nv), y' of variable c − nv (c < 2nv), input c − 2nv.
   std::vector<sym::Expr> symbols;
   std::vector<int> columnOf;  // of each symbol
@@ -65,9 +68,12 @@ bool DaeJacobians::evaluate(PointValues& p, JacobianValues& out) {
     int r = output ? e.row - static_cast<int>(n) : e.row;
     size_t c = e.column;
     double v = values_[e.root];
-    if (c < nv) (output ? out.GY : out.Y)(r, c) = v;
-    else if (c < 2 * nv) (output ? out.GYp : out.Yp)(r, c - nv) = v;
-    else (output ? out.GU : out.U)(r, c - 2 * nv) = v;
+    if (c < nv)
+      (output ? out.GY : out.Y)(r, c) = v;
+    else if (c < 2 * nv)
+      (output ? out.GYp : out.Yp)(r, c - nv) = v;
+    else
+      (output ? out.GU : out.U)(r, c - 2 * nv) = v;
   }
   for (double v : values_)
     if (!std::isfinite(v)) return false;

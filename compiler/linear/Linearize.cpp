@@ -12,9 +12,9 @@
 namespace qdot::linear {
 namespace {
 
+using dae::UnknownRole;
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
-using dae::UnknownRole;
 
 std::vector<int> range(size_t n) {
   std::vector<int> out(n);
@@ -27,7 +27,7 @@ struct Structure {
   std::vector<int> states, algebraic, velocities;  ///< variable indices, in DAE order
   std::vector<int> coordinates;                    ///< the coordinates that are states
   std::vector<int> inputs;                         ///< parameter indices of the model's inputs
-  std::vector<int> kinematicRows, otherRows;       ///< q' = der(q), and the rest
+  std::vector<int> otherRows;                      ///< all but the kinematic rows q' = der(q)
 };
 
 std::string structureOf(const dae::Dae& d, Structure& s) {
@@ -37,12 +37,13 @@ std::string structureOf(const dae::Dae& d, Structure& s) {
       return "the model has constraints (multiplier " + v.name + "); linearizing it needs an unconstrained model";
     (v.kind == dae::VarKind::State ? s.states : s.algebraic).push_back(static_cast<int>(j));
     if (v.role == UnknownRole::Velocity) s.velocities.push_back(static_cast<int>(j));
-    if (v.role == UnknownRole::Coordinate && v.kind == dae::VarKind::State) s.coordinates.push_back(static_cast<int>(j));
+    if (v.role == UnknownRole::Coordinate && v.kind == dae::VarKind::State)
+      s.coordinates.push_back(static_cast<int>(j));
   }
   for (size_t k = 0; k < d.parameters.size(); ++k)
     if (d.parameters[k].input) s.inputs.push_back(static_cast<int>(k));
   for (size_t i = 0; i < d.equations.size(); ++i)
-    (d.equations[i].origin.kind == flat::OriginKind::Kinematic ? s.kinematicRows : s.otherRows).push_back(static_cast<int>(i));
+    if (d.equations[i].origin.kind != flat::OriginKind::Kinematic) s.otherRows.push_back(static_cast<int>(i));
   if (s.states.empty()) return "the model has no states: there is nothing to linearize";
   return "";
 }
@@ -102,12 +103,15 @@ std::string findEquilibrium(DaeJacobians& jac, PointValues& p, const Structure& 
   for (int j = 0; j < p.y.size(); ++j)
     if (std::find(s.velocities.begin(), s.velocities.end(), j) == s.velocities.end()) system.y.push_back(j);
   switch (newton(jac, p, system, iterations)) {
-    case NewtonOutcome::Converged: return "";
-    case NewtonOutcome::NotFinite: return "the equations are not finite at the start values";
+    case NewtonOutcome::Converged:
+      return "";
+    case NewtonOutcome::NotFinite:
+      return "the equations are not finite at the start values";
     case NewtonOutcome::Singular:
       return "no isolated static equilibrium near the start values (the Jacobian of the static equations, the "
              "stiffness matrix for a mechanical model, is singular there); --at start linearizes about the start state";
-    case NewtonOutcome::NoConvergence: break;
+    case NewtonOutcome::NoConvergence:
+      break;
   }
   return "Newton's method found no static equilibrium from the start values in 100 iterations; try --at start";
 }
@@ -118,9 +122,12 @@ std::string solveStartState(DaeJacobians& jac, PointValues& p, const Structure& 
   p.yp.setZero();
   switch (newton(jac, p, {range(equations), s.algebraic, s.states}, iterations)) {
     case NewtonOutcome::Converged:
-    case NewtonOutcome::Singular: return "";
-    case NewtonOutcome::NotFinite: return "the equations are not finite at the start state";
-    case NewtonOutcome::NoConvergence: break;
+    case NewtonOutcome::Singular:
+      return "";
+    case NewtonOutcome::NotFinite:
+      return "the equations are not finite at the start state";
+    case NewtonOutcome::NoConvergence:
+      break;
   }
   return "Newton's method found no state derivatives and algebraic unknowns consistent with the start state in "
          "100 iterations";
@@ -137,7 +144,8 @@ int velocityOf(const dae::Dae& d, int q) {
 // The Euler–Lagrange row of coordinate variable q, or -1.
 int rowOf(const dae::Dae& d, int q) {
   for (size_t i = 0; i < d.equations.size(); ++i)
-    if (d.equations[i].origin.kind == flat::OriginKind::EulerLagrange && d.equations[i].origin.variable == d.variables[q].flatVar)
+    if (d.equations[i].origin.kind == flat::OriginKind::EulerLagrange &&
+        d.equations[i].origin.variable == d.variables[q].flatVar)
       return static_cast<int>(i);
   return -1;
 }
@@ -182,7 +190,8 @@ bool positiveDefinite(const MatrixXd& M) {
 // ∂F/∂y_j for an algebraic unknown.
 MatrixXd derivativeMatrix(const dae::Dae& d, const JacobianValues& J) {
   MatrixXd P(J.Y.rows(), J.Y.cols());
-  for (size_t j = 0; j < d.variables.size(); ++j) P.col(j) = d.variables[j].kind == dae::VarKind::State ? J.Yp.col(j) : J.Y.col(j);
+  for (size_t j = 0; j < d.variables.size(); ++j)
+    P.col(j) = d.variables[j].kind == dae::VarKind::State ? J.Yp.col(j) : J.Y.col(j);
   return P;
 }
 
@@ -198,7 +207,8 @@ std::string indexReason(const dae::Dae& d, const Eigen::FullPivLU<MatrixXd>& lu)
       }
   }
   return "the DAE is not of index 1 at the operating point: its equations do not determine the state derivatives "
-         "and algebraic unknowns from the states" + (names.empty() ? "" : " (not determined: " + names + ")") +
+         "and algebraic unknowns from the states" +
+         (names.empty() ? "" : " (not determined: " + names + ")") +
          ", so it has no state-space form without index reduction (a constraint between coordinates, or an "
          "algebraic unknown whose equations vanish there, such as a force through a lever of length zero)";
 }
@@ -261,8 +271,9 @@ Linearization linearize(const dae::Dae& d, sym::Context& ctx, const ModelValues&
   // user's mistake, not a mode.
   m.mechanical = secondOrderForm(d, s, J);
   if (m.mechanical && !positiveDefinite(m.mechanical->M)) {
-    out.error = "the mass matrix is not positive definite at the operating point: check the masses and inertias "
-                "(the kinetic energy must be positive for every motion)";
+    out.error =
+        "the mass matrix is not positive definite at the operating point: check the masses and inertias "
+        "(the kinetic energy must be positive for every motion)";
     return out;
   }
   Eigen::FullPivLU<MatrixXd> P(derivativeMatrix(d, J));

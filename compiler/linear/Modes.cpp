@@ -12,7 +12,8 @@ namespace qdot::linear {
 namespace {
 
 // Scales v so that its largest component (by magnitude) is +1.
-template <class Vector> std::vector<double> normalised(const Vector& v) {
+template <class Vector>
+std::vector<double> normalised(const Vector& v) {
   Eigen::Index k = 0;
   v.cwiseAbs().maxCoeff(&k);
   std::vector<double> out(v.size());

@@ -70,7 +70,7 @@ Eigen::MatrixXd pointRow(const LinearModel& m) {
 void printStateSpace(std::ostream& os, const LinearModel& m) {
   const StateSpace& s = m.stateSpace;
   os << "# der(x) = A x + B u, y = C x + D u in deviations from " << pointText(m) << "\n";
-  block(os, "point", {"x"}, s.states, pointRow(m));
+  block(os, "point", {"value"}, s.states, pointRow(m));
   os << '\n';
   block(os, "A", s.states, s.states, s.A);
   os << '\n';

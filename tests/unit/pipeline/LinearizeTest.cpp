@@ -83,7 +83,8 @@ end Lag;
 
 // Compiles `source` and linearizes it with the run-time values `parameters`.
 template <class Result, class Compute>
-Result compiled(const char* source, const std::vector<std::string>& parameters, linear::OperatingPoint at, Compute compute) {
+Result compiled(const char* source, const std::vector<std::string>& parameters, linear::OperatingPoint at,
+                Compute compute) {
   Compilation c;
   EXPECT_TRUE(compileSource(c, "test.qd", source, "", Stage::Kernel));
   return compute(c, parameters, at);
@@ -199,7 +200,8 @@ mechanics
   potential = 0.5*k*x^2;
   dissipation = 0.5*c*der(x)^2;
 end Damped;
-)", "", Stage::Kernel));
+)",
+                            "", Stage::Kernel));
   LinearizeResult r = linearizeModel(c, {}, linear::OperatingPoint::Equilibrium);
   ASSERT_EQ(r.error, "");
   expectMatrix(r.model.stateSpace.A, (Eigen::Matrix2d() << 0, 1, -100, -1.5).finished());
