@@ -5,6 +5,10 @@
 //   a spring acting through a lever, r F = −k x: ω² = k / (r m); with r = 0 nothing determines F
 //   (index > 1: refused);
 //   a forced mass–spring–damper, input u: A = [[0, 1], [−k/m, −c/m]], B = [[0], [1/m]];
+//   a second mass m2 riding rigidly on x1 through a flow f2 (a row beyond the coordinates' own, as a
+//   coordinate eliminated as an alias leaves): M = m1 + m2, ω² = k / (m1 + m2);
+//   two free masses joined by a spring through flows f1 + f2 = 0: M = diag(m1, m2),
+//   K = k [[1, −1], [−1, 1]], ω² = k (m1 + m2) / (m1 m2) and a rigid-body mode (about the start state);
 //   the same mass driven through a first-order lag τ ḟ = u − f (not a mechanical system: the modes
 //   are the eigenvalues of A): ω = √(k/m) and the real rate −1/τ.
 #include <gtest/gtest.h>
@@ -51,6 +55,35 @@ mechanics
 equation
   r*F = -k*x;
 end Lever;
+)";
+
+constexpr const char* riding = R"(
+model Riding
+  parameter Real m1 = 1, m2 = 2, k = 54;
+  coordinate Real x1(start = 0.1);
+  Real f2;
+mechanics
+  kinetic = 0.5*m1*der(x1)^2;
+  potential = 0.5*k*x1^2;
+  force(x1) = -f2;
+equation
+  m2*der(der(x1)) = f2;
+end Riding;
+)";
+
+constexpr const char* freeFree = R"(
+model FreeFree
+  parameter Real m1 = 1, m2 = 2, k = 50;
+  coordinate Real x1(start = 0.1), x2;
+  Real f1, f2;
+mechanics
+  kinetic = 0.5*m1*der(x1)^2 + 0.5*m2*der(x2)^2;
+  force(x1) = f1;
+  force(x2) = f2;
+equation
+  f1 = -k*(x1 - x2);
+  f1 + f2 = 0;
+end FreeFree;
 )";
 
 constexpr const char* forced = R"(
@@ -144,6 +177,32 @@ TEST(Linearize, MasslessNodeBetweenTwoSprings) {
   EXPECT_EQ(r.system.coordinates, std::vector<std::string>{"x1"});  // x2 is algebraic: not a state
   ASSERT_TRUE(r.system.mechanical);
   expectRelative(r.system.mechanical->K(0, 0), 30.0 * 60 / 90);
+}
+
+TEST(Linearize, RowBeyondTheCoordinatesAddsItsMass) {
+  ModesResult r = modesOf(riding, {"m1=1", "m2=2", "k=54"});
+  ASSERT_EQ(r.error, "");
+  ASSERT_TRUE(r.system.mechanical);
+  expectRelative(r.system.mechanical->M(0, 0), 3);
+  ASSERT_EQ(r.modes.size(), 1u);
+  expectRelative(r.modes[0].omega, std::sqrt(54.0 / 3));
+}
+
+TEST(Linearize, FreeMassesJoinedThroughFlows) {
+  double m1 = 1, m2 = 2, k = 50;
+  ModesResult r = modesOf(freeFree, {"m1=1", "m2=2", "k=50"}, linear::OperatingPoint::Start);
+  ASSERT_EQ(r.error, "");
+  ASSERT_TRUE(r.system.mechanical);
+  expectMatrix(r.system.mechanical->M, Eigen::Vector2d(m1, m2).asDiagonal().toDenseMatrix());
+  expectMatrix(r.system.mechanical->K, (Eigen::Matrix2d() << k, -k, -k, k).finished());
+  ASSERT_EQ(r.modes.size(), 2u);
+  expectRelative(r.modes[0].omega, std::sqrt(k * (m1 + m2) / (m1 * m2)));
+  expectRelative(r.modes[0].shape[1] / r.modes[0].shape[0], -m1 / m2);  // momentum stays zero
+  EXPECT_FALSE(r.modes[1].oscillating);  // the rigid-body motion
+  EXPECT_NEAR(r.modes[1].shape[0], r.modes[1].shape[1], 1e-12);
+  // No isolated equilibrium: the pair can sit anywhere.
+  ModesResult anywhere = modesOf(freeFree);
+  EXPECT_NE(anywhere.error.find("no isolated static equilibrium"), std::string::npos) << anywhere.error;
 }
 
 TEST(Linearize, ForcedMassSpringDamperStateSpace) {
