@@ -9,6 +9,10 @@
 //   coordinate eliminated as an alias leaves): M = m1 + m2, ω² = k / (m1 + m2);
 //   two free masses joined by a spring through flows f1 + f2 = 0: M = diag(m1, m2),
 //   K = k [[1, −1], [−1, 1]], ω² = k (m1 + m2) / (m1 m2) and a rigid-body mode (about the start state);
+//   component models (connectors, flows, aliased potentials): a mass on a spring and a damper to a
+//   wall, ω = √(k/m), ζ = c/(2√(km)); two masses between three springs, √(k/m) and √(3k/m); a mass
+//   on two springs in series (a massless junction), ω² = k1 k2 / ((k1 + k2) m); a mass pushed by an
+//   input through a connector: A and B as for the flat forced mass;
 //   the same mass driven through a first-order lag τ ḟ = u − f (not a mechanical system: the modes
 //   are the eigenvalues of A): ω = √(k/m) and the real rate −1/τ.
 #include <gtest/gtest.h>
@@ -114,6 +118,103 @@ equation
 end Lag;
 )";
 
+// A small translational library: the potential s is the position, the flow f the force on the
+// component through the port.
+constexpr const char* library = R"(
+connector Flange
+  Real s;
+  flow Real f;
+end Flange;
+model Fixed
+  parameter Real s0 = 0;
+  Flange a;
+equation
+  a.s = s0;
+end Fixed;
+model Mass
+  parameter Real m = 1;
+  Flange a, b;
+mechanics
+  kinetic = 0.5*m*der(a.s)^2;
+equation
+  b.s = a.s;
+end Mass;
+model Spring
+  parameter Real k = 1;
+  Flange a, b;
+mechanics
+  potential = 0.5*k*(b.s - a.s)^2;
+end Spring;
+model Damper
+  parameter Real c = 1;
+  Flange a, b;
+mechanics
+  dissipation = 0.5*c*(der(b.s) - der(a.s))^2;
+end Damper;
+model Push "applies the force u to what it is connected to"
+  Flange a;
+  Real u;
+equation
+  a.f = -u;
+end Push;
+)";
+
+constexpr const char* componentOscillator = R"(
+model Oscillator
+  Fixed wall;
+  Spring sp(k = 50);
+  Damper d(c = 3);
+  Mass m1(m = 2);
+equation
+  connect(wall.a, sp.a);
+  connect(sp.b, m1.a);
+  connect(wall.a, d.a);
+  connect(d.b, m1.a);
+end Oscillator;
+)";
+
+constexpr const char* componentTwoMasses = R"(
+model TwoMasses
+  Fixed wall, wall2;
+  Spring s1(k = 50), s2(k = 50), s3(k = 50);
+  Mass m1(m = 2), m2(m = 2);
+equation
+  connect(wall.a, s1.a);
+  connect(s1.b, m1.a);
+  connect(m1.b, s2.a);
+  connect(s2.b, m2.a);
+  connect(m2.b, s3.a);
+  connect(s3.b, wall2.a);
+end TwoMasses;
+)";
+
+constexpr const char* componentSeriesSprings = R"(
+model SeriesSprings
+  Fixed wall;
+  Spring s1(k = 30), s2(k = 60);
+  Mass m1(m = 2);
+equation
+  connect(wall.a, s2.a);
+  connect(s2.b, s1.a);
+  connect(s1.b, m1.a);
+end SeriesSprings;
+)";
+
+constexpr const char* componentPushed = R"(
+model Pushed
+  input Real u;
+  Fixed wall;
+  Spring sp(k = 50);
+  Mass m1(m = 2);
+  Push p;
+equation
+  connect(wall.a, sp.a);
+  connect(sp.b, m1.a);
+  connect(m1.b, p.a);
+  p.u = u;
+end Pushed;
+)";
+
 // Compiles `source` and linearizes it with the run-time values `parameters`.
 template <class Result, class Compute>
 Result compiled(const char* source, const std::vector<std::string>& parameters, linear::OperatingPoint at,
@@ -198,11 +299,51 @@ TEST(Linearize, FreeMassesJoinedThroughFlows) {
   ASSERT_EQ(r.modes.size(), 2u);
   expectRelative(r.modes[0].omega, std::sqrt(k * (m1 + m2) / (m1 * m2)));
   expectRelative(r.modes[0].shape[1] / r.modes[0].shape[0], -m1 / m2);  // momentum stays zero
-  EXPECT_FALSE(r.modes[1].oscillating);  // the rigid-body motion
+  EXPECT_FALSE(r.modes[1].oscillating);                                 // the rigid-body motion
   EXPECT_NEAR(r.modes[1].shape[0], r.modes[1].shape[1], 1e-12);
   // No isolated equilibrium: the pair can sit anywhere.
   ModesResult anywhere = modesOf(freeFree);
   EXPECT_NE(anywhere.error.find("no isolated static equilibrium"), std::string::npos) << anywhere.error;
+}
+
+std::string component(const char* model) { return std::string(library) + model; }
+
+TEST(Linearize, ComponentModelsModes) {
+  ModesResult oscillator = modesOf(component(componentOscillator).c_str());
+  ASSERT_EQ(oscillator.error, "");
+  ASSERT_TRUE(oscillator.system.mechanical);  // the flows eliminated from the rows
+  expectRelative(oscillator.system.mechanical->M(0, 0), 2);
+  expectRelative(oscillator.system.mechanical->C(0, 0), 3);
+  expectRelative(oscillator.system.mechanical->K(0, 0), 50);
+  ASSERT_EQ(oscillator.modes.size(), 1u);
+  expectRelative(oscillator.modes[0].omega, std::sqrt(50.0 / 2));
+  expectRelative(oscillator.modes[0].zeta, 3 / (2 * std::sqrt(50.0 * 2)));
+
+  ModesResult two = modesOf(component(componentTwoMasses).c_str());
+  ASSERT_EQ(two.error, "");
+  ASSERT_TRUE(two.system.mechanical);
+  expectMatrix(two.system.mechanical->M, (Eigen::Matrix2d() << 2, 0, 0, 2).finished());
+  expectMatrix(two.system.mechanical->K, (Eigen::Matrix2d() << 100, -50, -50, 100).finished());
+  ASSERT_EQ(two.modes.size(), 2u);
+  expectRelative(two.modes[0].omega, std::sqrt(50.0 / 2));
+  expectRelative(two.modes[1].omega, std::sqrt(3 * 50.0 / 2));
+  EXPECT_NEAR(two.modes[1].shape[0], -two.modes[1].shape[1], 1e-12);
+
+  ModesResult series = modesOf(component(componentSeriesSprings).c_str());
+  ASSERT_EQ(series.error, "");
+  ASSERT_EQ(series.modes.size(), 1u);
+  EXPECT_EQ(series.system.coordinates.size(), 1u);  // the junction is algebraic
+  expectRelative(series.modes[0].omega, std::sqrt(30.0 * 60 / (90 * 2)));
+}
+
+TEST(Linearize, ComponentModelWithAnInput) {
+  LinearizeResult r = linearized(component(componentPushed).c_str(), {"u=5"});
+  ASSERT_EQ(r.error, "");
+  const linear::StateSpace& s = r.model.stateSpace;
+  EXPECT_EQ(s.inputs, std::vector<std::string>{"u"});
+  expectMatrix(s.A, (Eigen::Matrix2d() << 0, 1, -25, 0).finished());
+  expectMatrix(s.B, Eigen::Vector2d(0, 0.5));
+  expectRelative(r.model.point[0], 5.0 / 50, 1e-12);  // pushed out by u/k
 }
 
 TEST(Linearize, ForcedMassSpringDamperStateSpace) {
