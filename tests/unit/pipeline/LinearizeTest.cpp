@@ -12,7 +12,8 @@
 //   component models (connectors, flows, aliased potentials): a mass on a spring and a damper to a
 //   wall, ω = √(k/m), ζ = c/(2√(km)); two masses between three springs, √(k/m) and √(3k/m); a mass
 //   on two springs in series (a massless junction), ω² = k1 k2 / ((k1 + k2) m); a mass pushed by an
-//   input through a connector: A and B as for the flat forced mass;
+//   input through a connector: A and B as for the flat forced mass; a spring and a damper in
+//   parallel without a mass, pushed by u (the coordinate first-order): c ẋ + k x = u, A = −k/c, B = 1/c;
 //   the same mass driven through a first-order lag τ ḟ = u − f (not a mechanical system: the modes
 //   are the eigenvalues of A): ω = √(k/m) and the real rate −1/τ.
 #include <gtest/gtest.h>
@@ -200,6 +201,22 @@ equation
 end SeriesSprings;
 )";
 
+constexpr const char* componentCreep = R"(
+model Creep
+  input Real u;
+  Fixed wall;
+  Spring sp(k = 50);
+  Damper d(c = 5);
+  Push p;
+equation
+  connect(wall.a, sp.a);
+  connect(wall.a, d.a);
+  connect(sp.b, d.b);
+  connect(sp.b, p.a);
+  p.u = u;
+end Creep;
+)";
+
 constexpr const char* componentPushed = R"(
 model Pushed
   input Real u;
@@ -344,6 +361,15 @@ TEST(Linearize, ComponentModelWithAnInput) {
   expectMatrix(s.A, (Eigen::Matrix2d() << 0, 1, -25, 0).finished());
   expectMatrix(s.B, Eigen::Vector2d(0, 0.5));
   expectRelative(r.model.point[0], 5.0 / 50, 1e-12);  // pushed out by u/k
+
+  ModesResult creep = modesOf(component(componentCreep).c_str());
+  ASSERT_EQ(creep.error, "");
+  EXPECT_FALSE(creep.system.mechanical);  // its velocity is algebraic: a first-order coordinate
+  expectMatrix(creep.system.stateSpace.A, Eigen::Matrix<double, 1, 1>(-50.0 / 5));
+  expectMatrix(creep.system.stateSpace.B, Eigen::Matrix<double, 1, 1>(1 / 5.0));
+  ASSERT_EQ(creep.modes.size(), 1u);
+  EXPECT_FALSE(creep.modes[0].oscillating);
+  expectRelative(creep.modes[0].rate, -10);
 }
 
 TEST(Linearize, ForcedMassSpringDamperStateSpace) {
