@@ -1,4 +1,4 @@
-// qdot modes (see Modes.h).
+// qdot modes and qdot linearize (see Modes.h).
 #include "driver/Modes.h"
 
 #include "sim/Names.h"
@@ -8,8 +8,8 @@
 namespace qdot::driver {
 namespace {
 
-ModesResult failed(ExitCode code, std::string why) {
-  ModesResult r;
+LinearizeResult failed(ExitCode code, std::string why) {
+  LinearizeResult r;
   r.code = code;
   r.error = std::move(why);
   return r;
@@ -17,7 +17,7 @@ ModesResult failed(ExitCode code, std::string why) {
 
 }  // namespace
 
-ModesResult computeModes(Compilation& c, const std::vector<std::string>& parameters, linear::OperatingPoint at) {
+LinearizeResult linearizeModel(Compilation& c, const std::vector<std::string>& parameters, linear::OperatingPoint at) {
   if (!continueTo(c, Stage::Bytecode)) return failed(ExitCode::ModelError, "the model has errors");
   Result<ModelPtr> model = vm::createModel(*c.bytecode);
   if (!model) return failed(ExitCode::Internal, model.error());
@@ -36,9 +36,15 @@ ModesResult computeModes(Compilation& c, const std::vector<std::string>& paramet
     return failed(ExitCode::ModelError, std::string("the start values cannot be computed: ") + m.lastError(&m));
   linear::Linearization l = linear::linearize(*c.dae, c.ctx, values, at);
   if (!l.error.empty()) return failed(ExitCode::ModelError, l.error);
-  ModesResult r;
-  r.system = std::move(l.system);
-  r.modes = linear::modes(r.system);
+  LinearizeResult r;
+  r.model = std::move(l.model);
+  return r;
+}
+
+ModesResult computeModes(Compilation& c, const std::vector<std::string>& parameters, linear::OperatingPoint at) {
+  LinearizeResult l = linearizeModel(c, parameters, at);
+  ModesResult r{l.code, std::move(l.error), std::move(l.model), {}};
+  if (r.error.empty()) r.modes = linear::modes(r.system);
   return r;
 }
 

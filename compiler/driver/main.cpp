@@ -21,7 +21,7 @@ namespace {
 
 using namespace qdot;
 
-enum class Action { Check, Equations, Run, Build, Modes };
+enum class Action { Check, Equations, Run, Build, Modes, Linearize };
 
 struct Options {
   std::string file;
@@ -35,7 +35,7 @@ struct Options {
   rt::RunOptions run;
   driver::ExecutableOptions exe;
   std::string buildBackend = "llvm";
-  std::string at = "equilibrium";  // modes --at
+  std::string at = "equilibrium";  // modes/linearize --at
 };
 
 ExitCode finish(driver::Compilation& c, bool ok) {
@@ -183,6 +183,21 @@ ExitCode modes(driver::Compilation& c, Options& o) {
   return ExitCode::Success;
 }
 
+// qdot linearize: the state-space matrices A, B, C, D about the operating point.
+ExitCode linearize(driver::Compilation& c, Options& o) {
+  if (std::optional<ExitCode> failed = compileToKernels(c, o)) return *failed;
+  c.diags.render(std::cerr, c.sources, isatty(2));  // warnings, if any
+  auto at = o.at == "start" ? linear::OperatingPoint::Start : linear::OperatingPoint::Equilibrium;
+  driver::LinearizeResult r = driver::linearizeModel(c, o.run.parameters, at);
+  if (!r.error.empty()) {
+    std::cerr << "error: " << r.error << "\n";
+    return r.code;
+  }
+  if (o.json) linear::printStateSpaceJson(std::cout, r.model);
+  else linear::printStateSpace(std::cout, r.model);
+  return ExitCode::Success;
+}
+
 ExitCode dispatch(Action action, Options& o) {
   driver::Compilation c;
   c.options.model = o.model;
@@ -193,6 +208,7 @@ ExitCode dispatch(Action action, Options& o) {
     case Action::Run: return run(c, o);
     case Action::Build: return build(c, o);
     case Action::Modes: return modes(c, o);
+    case Action::Linearize: return linearize(c, o);
   }
   return ExitCode::Internal;
 }
@@ -252,11 +268,18 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"equilibrium", "start"}));
   modesCmd->add_flag("--json", o.json, "print JSON for tools instead of text");
 
+  auto* linearizeCmd = addCommand(app, "linearize", "State-space matrices A, B, C, D of the model linearized about an operating point (inputs: its 'input' variables)", o);
+  linearizeCmd->add_option("-p,--parameter", o.run.parameters, "set a parameter or an input: -p NAME=VALUE (repeatable)")
+      ->allow_extra_args(false);
+  linearizeCmd->add_option("--at", o.at, "linearize about the static equilibrium nearest the start values (default) or the start state")
+      ->check(CLI::IsMember({"equilibrium", "start"}));
+  linearizeCmd->add_flag("--json", o.json, "print JSON for tools instead of CSV blocks");
+
   std::string first = argc > 1 ? argv[1] : "";
   bool known = false;
   for (const CLI::App* cmd : app.get_subcommands({})) known = known || cmd->get_name() == first;
   if (!first.empty() && first[0] != '-' && !known) {
-    std::cerr << "qdot: unknown command '" << first << "'; the commands are: check, equations, run, build, modes (see qdot --help)\n";
+    std::cerr << "qdot: unknown command '" << first << "'; the commands are: check, equations, run, build, modes, linearize (see qdot --help)\n";
     return toInt(ExitCode::Usage);
   }
   if (argc == 1) {
@@ -269,7 +292,12 @@ int main(int argc, char** argv) {
     int code = app.exit(e);
     return code == 0 ? 0 : toInt(ExitCode::Usage);
   }
-  Action action = *check ? Action::Check : *eqs ? Action::Equations : *run ? Action::Run : *build ? Action::Build : Action::Modes;
+  Action action = *check ? Action::Check
+                  : *eqs ? Action::Equations
+                  : *run ? Action::Run
+                  : *build ? Action::Build
+                  : *modesCmd ? Action::Modes
+                  : Action::Linearize;
   if (action == Action::Build && o.emit.empty() && o.exe.outputPath.empty()) {
     std::cerr << "qdot build: -o,--output is required (the executable to write)\nRun with --help for more information.\n";
     return toInt(ExitCode::Usage);

@@ -1,152 +1,288 @@
-// M, C, K of the Euler–Lagrange rows by symbolic differentiation, evaluated at an operating point
-// found by Newton's method on the static rows (velocities and accelerations zero).
+// The DAE linearized about an operating point found by Newton's method: the state-space form by
+// eliminating the algebraic unknowns (index 1), and M, C, K for the coordinates when the model is a
+// second-order mechanical one.
 #include "linear/Linearize.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
-#include <limits>
+
+#include "linear/DaeJacobians.h"
 
 namespace qdot::linear {
 namespace {
 
-using sym::Expr;
+using dae::UnknownRole;
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
 
-// The symbols of coordinate j: q, q̇ (its velocity variable's y) and q̈ (that variable's y').
-struct CoordinateSymbols {
-  Expr q = nullptr, v = nullptr, a = nullptr;
-  int qVar = -1, vVar = -1;
+std::vector<int> range(size_t n) {
+  std::vector<int> out(n);
+  for (size_t i = 0; i < n; ++i) out[i] = static_cast<int>(i);
+  return out;
+}
+
+// Which variables, rows and inputs play which part.
+struct Structure {
+  std::vector<int> states, algebraic, velocities;  ///< variable indices, in DAE order
+  std::vector<int> coordinates;                    ///< the coordinates that are states
+  std::vector<int> inputs;                         ///< parameter indices of the model's inputs
+  std::vector<int> otherRows;                      ///< all but the kinematic rows q' = der(q)
 };
 
-std::string findCoordinates(const dae::Dae& d, std::vector<CoordinateSymbols>& out) {
-  for (const auto& v : d.variables)
-    if (v.role == dae::UnknownRole::Multiplier)
-      return "the model has constraints (multiplier " + v.name + "); modes need an unconstrained model";
-  for (int qi : d.coordinates) {
-    CoordinateSymbols c;
-    c.q = d.variables[qi].y;
-    c.qVar = qi;
-    std::string velocity = "der(" + d.variables[qi].name + ")";
-    for (size_t j = 0; j < d.variables.size(); ++j)
-      if (d.variables[j].name == velocity && d.variables[j].yp) c.vVar = static_cast<int>(j);
-    if (c.vVar < 0)
-      return "coordinate " + d.variables[qi].name + " has no inertia (no acceleration in its equation of motion)";
-    c.v = d.variables[c.vVar].y;
-    c.a = d.variables[c.vVar].yp;
-    out.push_back(c);
+std::string structureOf(const dae::Dae& d, Structure& s) {
+  for (size_t j = 0; j < d.variables.size(); ++j) {
+    const dae::Variable& v = d.variables[j];
+    if (v.role == UnknownRole::Multiplier)
+      return "the model has constraints (multiplier " + v.name + "); linearizing it needs an unconstrained model";
+    (v.kind == dae::VarKind::State ? s.states : s.algebraic).push_back(static_cast<int>(j));
+    if (v.role == UnknownRole::Velocity) s.velocities.push_back(static_cast<int>(j));
+    if (v.role == UnknownRole::Coordinate && v.kind == dae::VarKind::State)
+      s.coordinates.push_back(static_cast<int>(j));
   }
-  if (out.empty()) return "the model has no coordinates";
+  for (size_t k = 0; k < d.parameters.size(); ++k)
+    if (d.parameters[k].input) s.inputs.push_back(static_cast<int>(k));
+  for (size_t i = 0; i < d.equations.size(); ++i)
+    if (d.equations[i].origin.kind != flat::OriginKind::Kinematic) s.otherRows.push_back(static_cast<int>(i));
+  if (s.states.empty()) return "the model has no states: there is nothing to linearize";
   return "";
 }
 
-// The rows and their partial derivatives with respect to a, v, q, evaluated together.
-class RowJacobians {
- public:
-  RowJacobians(const dae::Dae& d, sym::Context& ctx, const std::vector<CoordinateSymbols>& cs) : cs_(cs) {
-    size_t n = cs.size();
-    for (size_t i = 0; i < n; ++i) roots_.push_back(d.equations[i].residual);
-    for (auto pick : {&CoordinateSymbols::a, &CoordinateSymbols::v, &CoordinateSymbols::q})
-      for (size_t i = 0; i < n; ++i)
-        for (size_t j = 0; j < n; ++j) roots_.push_back(ctx.diff(d.equations[i].residual, cs[j].*pick));
-  }
-
-  /// Evaluates everything at `values`; false if a value is not finite (a row depends on something
-  /// that is not a coordinate, velocity, parameter or time, or the point is singular).
-  bool evaluate(std::span<const double> values, Eigen::VectorXd& F, Eigen::MatrixXd& M, Eigen::MatrixXd& C,
-                Eigen::MatrixXd& K) const {
-    size_t n = cs_.size();
-    std::vector<double> out(roots_.size());
-    sym::evaluate(roots_, values, out);
-    F.resize(n), M.resize(n, n), C.resize(n, n), K.resize(n, n);
-    for (size_t i = 0; i < n; ++i) F(i) = out[i];
-    Eigen::MatrixXd* mats[3] = {&M, &C, &K};
-    for (size_t m = 0; m < 3; ++m)
-      for (size_t i = 0; i < n; ++i)
-        for (size_t j = 0; j < n; ++j) (*mats[m])(i, j) = out[n + m * n * n + i * n + j];
-    for (double x : out)
-      if (!std::isfinite(x)) return false;
-    return true;
-  }
-
- private:
-  const std::vector<CoordinateSymbols>& cs_;
-  std::vector<Expr> roots_;
+// One Newton solve: the rows it zeroes, and its unknowns (y of some variables, y' of others);
+// everything else at the point stays as it is.
+struct NewtonSystem {
+  std::vector<int> rows, y, yp;
 };
 
-struct Point {
-  std::vector<double> values;  ///< by symbol id
-  const std::vector<CoordinateSymbols>* cs;
-  void set(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& a) {
-    for (size_t j = 0; j < cs->size(); ++j) {
-      values[(*cs)[j].q->symbolId] = q(j);
-      values[(*cs)[j].v->symbolId] = v(j);
-      values[(*cs)[j].a->symbolId] = a(j);
-    }
-  }
-};
+enum class NewtonOutcome { Converged, NotFinite, Singular, NoConvergence };
 
-// Newton on F(q, 0, 0) = 0 with K as the Jacobian, halving steps that do not reduce |F|.
-std::string findEquilibrium(const RowJacobians& rows, Point& p, Eigen::VectorXd& q, int& iterations) {
-  Eigen::VectorXd zero = Eigen::VectorXd::Zero(q.size()), F, Fn;
-  Eigen::MatrixXd M, C, K;
+VectorXd unknownsOf(const PointValues& p, const NewtonSystem& s) {
+  VectorXd x(s.y.size() + s.yp.size());
+  x << p.y(s.y), p.yp(s.yp);
+  return x;
+}
+
+void setUnknowns(PointValues& p, const NewtonSystem& s, const VectorXd& x) {
+  p.y(s.y) = x.head(s.y.size());
+  p.yp(s.yp) = x.tail(s.yp.size());
+}
+
+// Newton's method with step halving (steps that do not reduce |F| are halved). The point is left
+// at the solution, or where the Jacobian was singular.
+NewtonOutcome newton(DaeJacobians& jac, PointValues& p, const NewtonSystem& s, int& iterations) {
+  VectorXd x = unknownsOf(p, s);
+  JacobianValues J;
   for (iterations = 0; iterations < 100; ++iterations) {
-    p.set(q, zero, zero);
-    if (!rows.evaluate(p.values, F, M, C, K)) return "the equations of motion are not finite at q = start";
-    double scale = std::max(1.0, K.cwiseAbs().maxCoeff() * (1 + q.cwiseAbs().maxCoeff()));
-    if (F.cwiseAbs().maxCoeff() <= 1e-13 * scale) return "";
-    Eigen::FullPivLU<Eigen::MatrixXd> lu(K);
-    if (!lu.isInvertible())
-      return "no isolated static equilibrium near the start values (the stiffness matrix is singular there); "
-             "--at start linearizes about the start state";
-    Eigen::VectorXd step = lu.solve(-F);
+    setUnknowns(p, s, x);
+    if (!jac.evaluate(p, J)) return NewtonOutcome::NotFinite;
+    VectorXd F = J.F(s.rows);
+    MatrixXd jacobian(s.rows.size(), x.size());
+    jacobian << J.Y(s.rows, s.y), J.Yp(s.rows, s.yp);
+    double scale = std::max(1.0, jacobian.cwiseAbs().maxCoeff() * (1 + x.cwiseAbs().maxCoeff()));
+    if (F.cwiseAbs().maxCoeff() <= 1e-13 * scale) return NewtonOutcome::Converged;
+    Eigen::FullPivLU<MatrixXd> lu(jacobian);
+    if (jacobian.rows() != jacobian.cols() || !lu.isInvertible()) return NewtonOutcome::Singular;
+    VectorXd step = lu.solve(-F);
     double t = 1;
     for (int halvings = 0; halvings < 40; ++halvings, t /= 2) {
-      p.set(q + t * step, zero, zero);
-      if (rows.evaluate(p.values, Fn, M, C, K) && Fn.norm() < F.norm()) break;
+      setUnknowns(p, s, x + t * step);
+      if (jac.evaluate(p, J) && J.F(s.rows).norm() < F.norm()) break;
     }
-    q += t * step;
-    if (step.cwiseAbs().maxCoeff() * t <= 1e-15 * (1 + q.cwiseAbs().maxCoeff())) return "";
+    x += t * step;
+    setUnknowns(p, s, x);
+    if (step.cwiseAbs().maxCoeff() * t <= 1e-15 * (1 + x.cwiseAbs().maxCoeff())) return NewtonOutcome::Converged;
   }
-  return "Newton's method found no static equilibrium from the start values in 100 iterations; "
-         "try --at start";
+  return NewtonOutcome::NoConvergence;
+}
+
+// Velocities and state derivatives zero; the other rows solved for every other y.
+std::string findEquilibrium(DaeJacobians& jac, PointValues& p, const Structure& s, int& iterations) {
+  p.yp.setZero();
+  p.y(s.velocities).setZero();
+  NewtonSystem system{s.otherRows, {}, {}};
+  for (int j = 0; j < p.y.size(); ++j)
+    if (std::find(s.velocities.begin(), s.velocities.end(), j) == s.velocities.end()) system.y.push_back(j);
+  switch (newton(jac, p, system, iterations)) {
+    case NewtonOutcome::Converged:
+      return "";
+    case NewtonOutcome::NotFinite:
+      return "the equations are not finite at the start values";
+    case NewtonOutcome::Singular:
+      return "no isolated static equilibrium near the start values (the Jacobian of the static equations, the "
+             "stiffness matrix for a mechanical model, is singular there); --at start linearizes about the start state";
+    case NewtonOutcome::NoConvergence:
+      break;
+  }
+  return "Newton's method found no static equilibrium from the start values in 100 iterations; try --at start";
+}
+
+// The states at their start values; their derivatives and the algebraic unknowns solved from all
+// rows. A singular Jacobian is diagnosed at the point where Newton stopped, by linearize.
+std::string solveStartState(DaeJacobians& jac, PointValues& p, const Structure& s, size_t equations, int& iterations) {
+  p.yp.setZero();
+  switch (newton(jac, p, {range(equations), s.algebraic, s.states}, iterations)) {
+    case NewtonOutcome::Converged:
+    case NewtonOutcome::Singular:
+      return "";
+    case NewtonOutcome::NotFinite:
+      return "the equations are not finite at the start state";
+    case NewtonOutcome::NoConvergence:
+      break;
+  }
+  return "Newton's method found no state derivatives and algebraic unknowns consistent with the start state in "
+         "100 iterations";
+}
+
+// The velocity variable der(q) of each coordinate that is a state (a state itself, else -1).
+int velocityOf(const dae::Dae& d, int q) {
+  std::string velocity = "der(" + d.variables[q].name + ")";
+  for (size_t j = 0; j < d.variables.size(); ++j)
+    if (d.variables[j].name == velocity && d.variables[j].kind == dae::VarKind::State) return static_cast<int>(j);
+  return -1;
+}
+
+// The Euler–Lagrange row of coordinate variable q, or -1.
+int rowOf(const dae::Dae& d, int q) {
+  for (size_t i = 0; i < d.equations.size(); ++i)
+    if (d.equations[i].origin.kind == flat::OriginKind::EulerLagrange &&
+        d.equations[i].origin.variable == d.variables[q].flatVar)
+      return static_cast<int>(i);
+  return -1;
+}
+
+// M, C, K for the coordinates when every state is a coordinate q or its velocity v, each with its
+// Euler–Lagrange row, and the other non-kinematic rows determine the algebraic unknowns z: the
+// rows read E_a a + A_v v + A_q q + A_z z = 0, and z is eliminated with the other rows (block 2)
+// from the coordinates' rows (block 1): M = E_a1 − A_z1 A_z2⁻¹ E_a2, and so on. (A row that uses
+// q' means v: the kinematic rows say so.) Without algebraic unknowns these are the rows' own M, C, K.
+std::optional<SecondOrderSystem> secondOrderForm(const dae::Dae& d, const Structure& s, const JacobianValues& J) {
+  std::vector<int> q = s.coordinates, v, rows1, rows2;
+  for (int j : q) {
+    v.push_back(velocityOf(d, j));
+    rows1.push_back(rowOf(d, j));
+    if (v.back() < 0 || rows1.back() < 0) return std::nullopt;
+  }
+  if (s.states.size() != 2 * q.size()) return std::nullopt;  // other states: a first-order part
+  for (int i : s.otherRows)
+    if (std::find(rows1.begin(), rows1.end(), i) == rows1.end()) rows2.push_back(i);
+  const std::vector<int>& z = s.algebraic;
+  if (rows2.size() != z.size()) return std::nullopt;
+  auto blocks = [&](const std::vector<int>& rows) {
+    return std::array<MatrixXd, 3>{J.Yp(rows, v), J.Y(rows, v) + J.Yp(rows, q), J.Y(rows, q)};
+  };
+  std::array<MatrixXd, 3> mck = blocks(rows1);
+  if (!z.empty()) {
+    Eigen::FullPivLU<MatrixXd> lu(J.Y(rows2, z));
+    if (!lu.isInvertible()) return std::nullopt;
+    MatrixXd eliminate = J.Y(rows1, z) * lu.inverse();
+    std::array<MatrixXd, 3> second = blocks(rows2);
+    for (size_t k = 0; k < 3; ++k) mck[k] -= eliminate * second[k];
+  }
+  return SecondOrderSystem{mck[0], mck[1], mck[2]};
+}
+
+bool positiveDefinite(const MatrixXd& M) {
+  Eigen::LLT<MatrixXd> llt(0.5 * (M + M.transpose()));
+  return llt.info() == Eigen::Success;
+}
+
+// The matrix of the linear equations for (ẋ, z) given x and u: column j is ∂F/∂y'_j for a state,
+// ∂F/∂y_j for an algebraic unknown.
+MatrixXd derivativeMatrix(const dae::Dae& d, const JacobianValues& J) {
+  MatrixXd P(J.Y.rows(), J.Y.cols());
+  for (size_t j = 0; j < d.variables.size(); ++j)
+    P.col(j) = d.variables[j].kind == dae::VarKind::State ? J.Yp.col(j) : J.Y.col(j);
+  return P;
+}
+
+// Why P is singular, naming the unknowns of one combination that the equations leave free.
+std::string indexReason(const dae::Dae& d, const Eigen::FullPivLU<MatrixXd>& lu) {
+  std::string names;
+  if (lu.rows() == lu.cols()) {
+    VectorXd free = lu.kernel().col(0);
+    for (int j = 0, listed = 0; j < free.size() && listed < 4; ++j)
+      if (std::fabs(free(j)) > 1e-8 * free.cwiseAbs().maxCoeff()) {
+        const dae::Variable& v = d.variables[j];
+        names += (listed++ ? ", " : "") + (v.kind == dae::VarKind::State ? "der(" + v.name + ")" : v.name);
+      }
+  }
+  return "the DAE is not of index 1 at the operating point: its equations do not determine the state derivatives "
+         "and algebraic unknowns from the states" +
+         (names.empty() ? "" : " (not determined: " + names + ")") +
+         ", so it has no state-space form without index reduction (a constraint between coordinates, or an "
+         "algebraic unknown whose equations vanish there, such as a force through a lever of length zero)";
+}
+
+// ẋ = A x + B u, y = C x + D u from the Jacobians at the point, with P = [∂F/∂x' ∂F/∂z] invertible:
+// (δẋ, δz) = −P⁻¹ (∂F/∂x δx + ∂F/∂u δu), and δy = ∂g/∂y δy + ∂g/∂y' δy'.
+StateSpace stateSpaceOf(const dae::Dae& d, const Structure& s, const JacobianValues& J,
+                        const Eigen::FullPivLU<MatrixXd>& P) {
+  const std::vector<int>& x = s.states;
+  size_t nx = x.size(), nu = s.inputs.size(), n = J.Y.rows();
+  MatrixXd rhs(n, nx + nu);
+  rhs << J.Y(Eigen::all, x), J.U;
+  MatrixXd W = -P.solve(rhs);  // row j: δẋ_j (a state) or δz_j (algebraic) per unit δx, δu
+  StateSpace ss;
+  ss.A = W(x, Eigen::seqN(0, nx));
+  ss.B = W(x, Eigen::seqN(nx, nu));
+  MatrixXd CD = J.GY(Eigen::all, s.algebraic) * W(s.algebraic, Eigen::all) + J.GYp(Eigen::all, x) * W(x, Eigen::all);
+  CD.leftCols(nx) += J.GY(Eigen::all, x);
+  CD.rightCols(nu) += J.GU;
+  ss.C = CD.leftCols(nx);
+  ss.D = CD.rightCols(nu);
+  for (int j : x) ss.states.push_back(d.variables[j].name);
+  for (int k : s.inputs) ss.inputs.push_back(d.parameters[k].name);
+  for (const auto& o : d.outputs) ss.outputs.push_back(o.name);
+  return ss;
+}
+
+// The names and values of the point, and where the coordinates are among the states.
+void describePoint(const dae::Dae& d, const Structure& s, const PointValues& p, LinearModel& m) {
+  for (int j : s.states) m.statePoint.push_back(p.y(j));
+  for (int q : s.coordinates) {
+    m.coordinates.push_back(d.variables[q].name);
+    m.point.push_back(p.y(q));
+    m.coordinateStates.push_back(static_cast<int>(std::find(s.states.begin(), s.states.end(), q) - s.states.begin()));
+  }
 }
 
 }  // namespace
 
 Linearization linearize(const dae::Dae& d, sym::Context& ctx, const ModelValues& values, OperatingPoint at) {
   Linearization out;
-  std::vector<CoordinateSymbols> cs;
-  if (out.error = findCoordinates(d, cs); !out.error.empty()) return out;
-  RowJacobians rows(d, ctx, cs);
-  Point p{std::vector<double>(ctx.symbolCount(), std::numeric_limits<double>::quiet_NaN()), &cs};
-  for (size_t k = 0; k < d.parameters.size(); ++k) p.values[d.parameters[k].symbol->symbolId] = values.parameters[k];
-  p.values[d.time->symbolId] = values.time;
-  size_t n = cs.size();
-  Eigen::VectorXd q(n), v = Eigen::VectorXd::Zero(n), a = Eigen::VectorXd::Zero(n), F;
-  for (size_t j = 0; j < n; ++j) q(j) = values.start[cs[j].qVar];
-  SecondOrderSystem& s = out.system;
-  if (at == OperatingPoint::Equilibrium) {
-    if (out.error = findEquilibrium(rows, p, q, s.newtonIterations); !out.error.empty()) return out;
-    s.equilibrium = true;
-  } else {
-    for (size_t j = 0; j < n; ++j) v(j) = values.start[cs[j].vVar];
-    p.set(q, v, a);  // the rows are linear in a: a = -M⁻¹ F(q, v, 0)
-    if (rows.evaluate(p.values, F, s.M, s.C, s.K)) a = s.M.fullPivLu().solve(-F);
-  }
-  p.set(q, v, a);
-  if (!rows.evaluate(p.values, F, s.M, s.C, s.K)) {
-    out.error = "the equations of motion depend on something other than coordinates, velocities, parameters "
-                "and time (an algebraic unknown), or are not finite at the operating point";
+  Structure s;
+  if (out.error = structureOf(d, s); !out.error.empty()) return out;
+  DaeJacobians jac(d, ctx, s.inputs);
+  PointValues p(d, ctx, values.parameters, values.time);
+  for (size_t j = 0; j < d.variables.size(); ++j) p.y(j) = values.start[j];
+  LinearModel& m = out.model;
+  m.equilibrium = at == OperatingPoint::Equilibrium;
+  m.time = values.time;
+  int startIterations = 0;  // not reported: newtonIterations counts the search for an equilibrium
+  out.error = m.equilibrium ? findEquilibrium(jac, p, s, m.newtonIterations)
+                            : solveStartState(jac, p, s, d.equations.size(), startIterations);
+  if (!out.error.empty()) return out;
+  JacobianValues J;
+  if (!jac.evaluate(p, J)) {
+    out.error = "the equations or their derivatives are not finite at the operating point";
     return out;
   }
   // T = ½ q̇ᵀ M q̇ must be positive for every motion: a zero or negative mass or inertia is the
   // user's mistake, not a mode.
-  if (Eigen::LLT<Eigen::MatrixXd> llt(0.5 * (s.M + s.M.transpose())); llt.info() != Eigen::Success) {
-    out.error = "the mass matrix is not positive definite at the operating point: check the masses and inertias "
-                "(the kinetic energy must be positive for every motion)";
+  m.mechanical = secondOrderForm(d, s, J);
+  if (m.mechanical && !positiveDefinite(m.mechanical->M)) {
+    out.error =
+        "the mass matrix is not positive definite at the operating point: check the masses and inertias "
+        "(the kinetic energy must be positive for every motion)";
     return out;
   }
-  for (size_t j = 0; j < n; ++j) s.coordinates.push_back(d.variables[cs[j].qVar].name);
-  s.point.assign(q.data(), q.data() + n);
-  s.time = values.time;
+  Eigen::FullPivLU<MatrixXd> P(derivativeMatrix(d, J));
+  if (!P.isInvertible()) {
+    out.error = indexReason(d, P);
+    return out;
+  }
+  m.stateSpace = stateSpaceOf(d, s, J, P);
+  describePoint(d, s, p, m);
   return out;
 }
 

@@ -20,7 +20,7 @@ std::string list(const std::vector<double>& v, const char* separator) {
 
 }  // namespace
 
-void printModes(std::ostream& os, const SecondOrderSystem& s, const std::vector<Mode>& modes) {
+void printModes(std::ostream& os, const LinearModel& s, const std::vector<Mode>& modes) {
   std::string names;
   for (const auto& c : s.coordinates) names += (names.empty() ? "" : ", ") + c;
   os << "operating point: " << names << " = " << list(s.point, ", ");
@@ -34,14 +34,14 @@ void printModes(std::ostream& os, const SecondOrderSystem& s, const std::vector<
     const Mode& m = modes[i];
     if (m.oscillating)
       os << fmt::format("{:>4}  {:>16.10g}  {:>16.10g}  {:>12.6g}  {}\n", i + 1, m.omega,
-                        m.omega / (2 * std::numbers::pi), m.zeta, list(m.shape, ", "));
+                        m.omega / (2 * std::numbers::pi), m.zeta == 0 ? 0.0 : m.zeta, list(m.shape, ", "));
     else
       os << fmt::format("{:>4}  {:>16}  {:>16}  {:>12}  {}   (not oscillating: e^({:.10g} t))\n", i + 1, "-", "-",
                         "-", list(m.shape, ", "), m.rate);
   }
 }
 
-void printModesJson(std::ostream& os, const SecondOrderSystem& s, const std::vector<Mode>& modes) {
+void printModesJson(std::ostream& os, const LinearModel& s, const std::vector<Mode>& modes) {
   auto array = [](const std::vector<double>& v) {
     std::string out = "[";
     for (size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + shortestText(v[i]);

@@ -99,6 +99,28 @@ contains modes-two-mass "17.32050808" "$qdot" modes "$src/examples/vibration/two
 check modes-json 0 sh -c "'$qdot' modes '$src/examples/vibration/two_mass_modes.qd' --json | python3 -m json.tool"
 check modes-no-equilibrium 1 "$qdot" modes "$src/examples/textbook/wedge.qd"
 check modes-bad-at 2 "$qdot" modes "$src/examples/textbook/utube.qd" --at nowhere
+# qdot linearize: the damped oscillator's row der(x) of A (−k/m, −c/m) as CSV; a forced mass's A and
+# B (1/m for its input u) as JSON, exactly; -p sets an input (the equilibrium moves to u/k).
+contains linearize-csv "der(x),-100,-2" "$qdot" linearize "$src/examples/vibration/damped_oscillator.qd"
+forced=/tmp/qdot_cli_forced.$$.qd
+cat >"$forced" <<'QD'
+model Forced
+  parameter Real m = 2, k = 50;
+  input Real u;
+  coordinate Real x;
+mechanics
+  kinetic = 0.5*m*der(x)^2;
+  potential = 0.5*k*x^2;
+  force(x) = u;
+end Forced;
+QD
+expect='import json, sys; d = json.load(sys.stdin); assert (d["states"], d["inputs"], d["A"], d["B"], d["point"]) == (["x", "der(x)"], ["u"], [[0, 1], [-25, 0]], [[0], [0.5]], [0.1, 0]), d'
+check linearize-json 0 sh -c "'$qdot' linearize '$forced' --json -p u=5 | python3 -c '$expect'"
+contains linearize-csv-input "B,u" "$qdot" linearize "$forced"
+rm -f "$forced"
+check linearize-no-equilibrium 1 "$qdot" linearize "$src/examples/textbook/wedge.qd"
+check linearize-at-start 0 "$qdot" linearize "$src/examples/textbook/wedge.qd" --at start
+check linearize-bad-p 2 "$qdot" linearize "$src/examples/textbook/utube.qd" -p nope=1
 for f in "$src"/examples/*/*.qd; do
   check "json-$(basename "$f")" 0 sh -c "'$qdot' equations '$f' --json | python3 -m json.tool"
 done

@@ -50,9 +50,10 @@ TEST(Modes, DampedOscillatorFrequencyAndDampingRatio) {
   ASSERT_EQ(r.modes.size(), 1u);
   expectRelative(r.modes[0].omega, std::sqrt(400.0 / 4));
   expectRelative(r.modes[0].zeta, 6 / (2 * std::sqrt(400.0 * 4)));
-  expectRelative(r.system.C(0, 0), 6);
-  expectRelative(r.system.K(0, 0), 400);
-  expectRelative(r.system.M(0, 0), 4);
+  ASSERT_TRUE(r.system.mechanical);
+  expectRelative(r.system.mechanical->C(0, 0), 6);
+  expectRelative(r.system.mechanical->K(0, 0), 400);
+  expectRelative(r.system.mechanical->M(0, 0), 4);
 }
 
 TEST(Modes, OverdampedOscillatorDoesNotOscillate) {
