@@ -14,6 +14,7 @@ std::string equationLabel(const Dae& dae, const Equation& eq, const sym::Context
     case flat::OriginKind::EulerLagrange: return "the Euler–Lagrange equation of a coordinate";
     case flat::OriginKind::Kinematic: return "a kinematic equation";
     case flat::OriginKind::Constraint: return "this constraint";
+    case flat::OriginKind::Connection: return "the flow balance " + sym::toString(ctx, eq.residual) + " = 0 of a connection";
     default: break;
   }
   std::string text = eq.lhs ? sym::toString(ctx, eq.lhs) + " = " + sym::toString(ctx, eq.rhs)

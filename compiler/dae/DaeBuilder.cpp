@@ -3,6 +3,8 @@
 #include "dae/Dae.h"
 #include "dae/Balance.h"
 
+#include <unordered_map>
+
 namespace qdot::dae {
 namespace {
 
@@ -22,13 +24,17 @@ class Builder {
     dae_.experiment = m_.experiment;
     dae_.structuralParameters = m_.structuralParameters;
     dae_.outputs = m_.outputs;
+    collectAliases();
     addParameters();
+    addEquations();
     dae_.variables.reserve(unknownCount());
     addMechanics();
+    insertKinematicRows();
     addUnknowns();
-    addEquations();
     for (const auto& fi : eom_.integrals)
-      dae_.invariants.push_back({fi.name, fi.kind == mech::FirstIntegral::Kind::Jacobi ? "Jacobi integral" : "cyclic momentum", fi.value});
+      dae_.invariants.push_back({fi.name, fi.kind == mech::FirstIntegral::Kind::Jacobi ? "Jacobi integral" : "cyclic momentum",
+                                 substituted(fi.value)});
+    if (!aliases_.empty()) substituteRest();
     // With constraints the system has index 3 and its structure is only checked once index
     // reduction exists (structural issue); until then the counts must agree.
     if (diags_.errorCount() == errorsBefore && eom_.multipliers.empty()) checkBalance(dae_, ctx_, diags_);
@@ -47,6 +53,36 @@ class Builder {
   DiagnosticEngine& diags_;
   Dae dae_;
   std::vector<Equation> kinematic_;
+  std::unordered_map<Expr, Expr> aliases_;  ///< symbol of a variable that is not an unknown → its value
+  std::vector<char> appears_;               ///< by symbol id: in some equation (after substitution)
+
+  // Connected potentials and their derivatives are one variable (FlatModel: Variable::alias).
+  void collectAliases() {
+    for (const auto& v : m_.variables)
+      if (v.alias) aliases_.emplace(v.symbol, v.alias);
+    // An alias of an alias (a value that is itself eliminated) resolves to the end of the chain.
+    for (auto& [from, to] : aliases_)
+      for (int guard = 0; guard < 8 && (to->symbolMask != 0); ++guard) {
+        Expr next = ctx_.substitute(to, aliases_);
+        if (next == to) break;
+        to = next;
+      }
+  }
+
+  Expr substituted(Expr e) { return aliases_.empty() || !e ? e : ctx_.substitute(e, aliases_); }
+
+  // Which symbols the equations contain: decides what kind of unknown each coordinate is.
+  void markAppearances() {
+    appears_.assign(ctx_.symbolCount(), 0);
+    for (const auto& eq : dae_.equations)
+      for (Expr s : ctx_.freeSymbols(eq.residual)) appears_[s->symbolId] = 1;
+  }
+  bool appears(Expr s) const { return s->symbolId < appears_.size() && appears_[s->symbolId]; }
+
+  void substituteRest() {
+    for (auto& o : dae_.outputs) o.value = substituted(o.value);
+    for (auto& v : dae_.variables) v.declaration.start = substituted(v.declaration.start);
+  }
 
   // At most: a coordinate and its velocity per row, every other unknown, every multiplier.
   size_t unknownCount() const {
@@ -75,11 +111,16 @@ class Builder {
   void addMechanics() {
     std::vector<Variable> velocities;
     velocities.reserve(eom_.rows.size());
+    markAppearances();
     for (const auto& row : eom_.rows) {
       const flat::Variable& q = m_.variables[row.coordinate];
+      if (q.alias) continue;  // its row stays an equation; it is another variable
       const flat::Variable& v = m_.variables[q.derivative];
+      const flat::Variable& a = m_.variables[v.derivative];
+      // Inertia shows as the acceleration in some row (an aliased coordinate's row counts).
+      bool inertial = appears(a.symbol);
       dae_.coordinates.push_back(static_cast<int>(dae_.variables.size()));
-      if (!row.inertial && !ctx_.dependsOn(row.residual, v.symbol)) {
+      if (!inertial && !appears(v.symbol)) {
         dae_.variables.push_back(fromFlat(row.coordinate, VarKind::Algebraic, UnknownRole::Coordinate));
         continue;
       }
@@ -87,9 +128,9 @@ class Builder {
       qv.yp = ctx_.symbol("$der(" + std::string(q.name) + ")");
       kinematic_.push_back({ctx_.sub(qv.yp, v.symbol), {flat::OriginKind::Kinematic, q.declRange, row.coordinate, ""}});
       dae_.variables.push_back(std::move(qv));
-      Variable vv = fromFlat(q.derivative, row.inertial ? VarKind::State : VarKind::Algebraic, UnknownRole::Velocity);
+      Variable vv = fromFlat(q.derivative, inertial ? VarKind::State : VarKind::Algebraic, UnknownRole::Velocity);
       vv.declaration.start = v.start ? v.start : ctx_.zero();  // a velocity starts at 0 unless an initial equation says otherwise
-      if (row.inertial) vv.yp = m_.variables[v.derivative].symbol;
+      if (inertial) vv.yp = a.symbol;
       velocities.push_back(std::move(vv));
     }
     dae_.variables.insert(dae_.variables.end(), std::make_move_iterator(velocities.begin()),
@@ -100,7 +141,7 @@ class Builder {
     std::vector<Variable> algebraic;
     for (int i = 0; i < static_cast<int>(m_.variables.size()); ++i) {
       const flat::Variable& f = m_.variables[i];
-      if (f.role != flat::VarRole::Unknown) continue;
+      if (f.role != flat::VarRole::Unknown || f.alias) continue;
       if (f.derivative >= 0) {
         Variable v = fromFlat(i, VarKind::State, UnknownRole::State);
         v.yp = m_.variables[f.derivative].symbol;
@@ -125,18 +166,25 @@ class Builder {
     dae_.equations.reserve(eom_.rows.size() + kinematic_.size() + m_.equations.size() + m_.constraints.size());
     for (const auto& row : eom_.rows) {
       const flat::Variable& q = m_.variables[row.coordinate];
-      dae_.equations.push_back({row.residual, {flat::OriginKind::EulerLagrange, q.declRange, row.coordinate, ""}});
+      dae_.equations.push_back({substituted(row.residual), {flat::OriginKind::EulerLagrange, q.declRange, row.coordinate, ""}});
     }
-    dae_.equations.insert(dae_.equations.end(), std::make_move_iterator(kinematic_.begin()),
-                          std::make_move_iterator(kinematic_.end()));
-    dae_.equations.insert(dae_.equations.end(), m_.equations.begin(), m_.equations.end());
+    for (const auto& eq : m_.equations)
+      dae_.equations.push_back({substituted(eq.residual), eq.origin, substituted(eq.lhs), substituted(eq.rhs)});
     for (size_t k = 0; k < m_.constraints.size(); ++k) {
       const auto& c = m_.constraints[k];
       flat::Origin o = c.origin;
       o.variable = static_cast<int>(k);
-      dae_.equations.push_back({c.residual, o, c.lhs, c.rhs});
+      dae_.equations.push_back({substituted(c.residual), o, substituted(c.lhs), substituted(c.rhs)});
     }
-    dae_.initialEquations = m_.initialEquations;
+    for (const auto& eq : m_.initialEquations)
+      dae_.initialEquations.push_back({substituted(eq.residual), eq.origin, substituted(eq.lhs), substituted(eq.rhs)});
+  }
+
+  // The kinematic rows go after the Euler–Lagrange rows (made by addMechanics, which needs to
+  // know which symbols the other equations contain).
+  void insertKinematicRows() {
+    dae_.equations.insert(dae_.equations.begin() + static_cast<long>(eom_.rows.size()),
+                          std::make_move_iterator(kinematic_.begin()), std::make_move_iterator(kinematic_.end()));
   }
 };
 

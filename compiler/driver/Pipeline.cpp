@@ -4,6 +4,7 @@
 #include "driver/Pipeline.h"
 
 #include <charconv>
+#include <filesystem>
 #include <chrono>
 #include <iostream>
 #include <iterator>
@@ -39,8 +40,16 @@ bool parse(Compilation& c, uint32_t file) {
   return c.ast && !c.diags.hasErrors();
 }
 
+// The model's file, or "" for text that is not a file (standard input, a test's buffer).
+std::string modelFilePath(const Compilation& c) {
+  const std::string& name = c.sources.name(c.ast->file);
+  return name.empty() || name.front() == '<' || !std::filesystem::is_regular_file(name) ? "" : name;
+}
+
 bool check(Compilation& c) {
-  c.checked = timed(c.times.check, [&] { return sema::checkModel(*c.ast, c.options.model, c.diags); });
+  c.libraries = std::make_unique<LibraryLoader>(libraryPath(modelFilePath(c)), c.sources, c.diags);
+  sema::Library library = c.libraries->library();
+  c.checked = timed(c.times.check, [&] { return sema::checkModel(*c.ast, c.options.model, c.diags, library); });
   if (!c.checked) reportMissingModel(c, c.ast->file);
   return c.checked && !c.diags.hasErrors();
 }
@@ -143,9 +152,8 @@ namespace {
 
 // The scalar Integer parameter `name` of the checked model, or null.
 const ast::Declaration* integerParameter(const sema::CheckedModel& m, const std::string& name) {
-  auto it = m.symbols.find(name);
-  if (it == m.symbols.end() || it->second.kind != sema::SymbolKind::IntegerParameter) return nullptr;
-  return it->second.decl;
+  const sema::ModelSymbol* s = m.root->find(name);
+  return s && s->kind == sema::SymbolKind::IntegerParameter ? s->decl : nullptr;
 }
 
 }  // namespace
@@ -175,7 +183,7 @@ std::string takeStructuralParameters(Compilation& c, std::vector<std::string>& a
 
 std::string structuralParameterList(const Compilation& c) {
   std::string list;
-  for (const ast::Declaration* d : c.checked->declarations)
+  for (const ast::Declaration* d : c.checked->root->declarations)
     if (integerParameter(*c.checked, d->name) == d) list += (list.empty() ? "" : ", ") + d->name;
   return list;
 }

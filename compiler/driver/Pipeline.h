@@ -22,6 +22,7 @@
 #include "mechanics/EulerLagrange.h"
 #include "qdot/bytecode.h"
 #include "qdot/result.hpp"
+#include "driver/LibraryPath.h"
 #include "sema/Sema.h"
 #include "support/Diagnostic.h"
 #include "symbolic/Expr.h"
@@ -56,6 +57,7 @@ struct Compilation {
   DiagnosticEngine diags;
   sym::Context ctx;
   std::unique_ptr<ast::StoredDefinition> ast;
+  std::unique_ptr<LibraryLoader> libraries;  ///< the packages the model imports (their trees)
   std::optional<sema::CheckedModel> checked;
   std::optional<flat::FlatModel> flat;
   std::optional<mech::EquationsOfMotion> eom;

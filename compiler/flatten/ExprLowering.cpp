@@ -70,17 +70,20 @@ Value Flattener::lower(const ast::Expr& e) {
       if (endContext_.empty()) QDOT_UNREACHABLE("'end' outside a subscript reached flattening");
       return Value::scalar(ctx_.constant(endContext_.back().first->shape[endContext_.back().second]));
     case ExprKind::String: fail(e.range, DiagCode::E0213, "a string is not allowed here");
-    case ExprKind::Member: fail(e.range, DiagCode::E0290, "component member access is not supported yet");
+    case ExprKind::Member: return lowerMember(*cast<MemberExpr>(&e));
   }
   QDOT_UNREACHABLE("lower: every expression kind is handled in the switch");
 }
 
 Value Flattener::lowerName(const NameExpr& n) {
+  if (n.parts.size() > 1) return lowerDotted(n);
   const std::string& name = n.parts[0];
   for (auto it = iterators_.rbegin(); it != iterators_.rend(); ++it)
     if (it->first == name) return Value::scalar(it->second);
-  auto s = m_.symbols.find(name);
-  if (s != m_.symbols.end()) return valueOf(*s->second.decl, n.range);
+  if (const sema::ModelSymbol* s = cur_->cls->find(name)) {
+    if (s->kind == sema::SymbolKind::Component) fail(n.range, DiagCode::E0224, "'" + name + "' is a component, not a value");
+    return valueOf(*cur_, *s->decl, n.range);
+  }
   if (name == "time") return Value::scalar(out_.time());
   if (name == "pi") return Value::scalar(ctx_.constant(std::numbers::pi));
   fail(n.range, DiagCode::E0202, "unknown name '" + name + "'");
@@ -132,11 +135,11 @@ std::vector<int> Flattener::subscriptIndices(const ast::Expr& s, int dimSize) {
 // The array being subscripted, without copying it when it is a declared name (x[i] in a loop
 // over a large array must not copy x each time).
 const Value& Flattener::subscriptBase(const ast::Expr& e, Value& holder) {
-  if (auto* n = dyn_cast<NameExpr>(&e)) {
+  if (auto* n = dyn_cast<NameExpr>(&e); n && n->parts.size() == 1) {
     bool isIterator = false;
     for (const auto& it : iterators_) isIterator |= it.first == n->parts[0];
-    auto s = m_.symbols.find(n->parts[0]);
-    if (!isIterator && s != m_.symbols.end()) return valueOf(*s->second.decl, n->range);
+    const sema::ModelSymbol* s = cur_->cls->find(n->parts[0]);
+    if (!isIterator && s && s->kind != sema::SymbolKind::Component) return valueOf(*cur_, *s->decl, n->range);
   }
   holder = lower(e);
   return holder;

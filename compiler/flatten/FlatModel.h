@@ -43,6 +43,10 @@ struct Variable {
   sym::Expr value = nullptr;  ///< Parameter: default value (over other parameters)
   int derivative = -1;        ///< index of the variable that is der(this), -1 if none
   int derivativeOf = -1;      ///< this is der(variables[derivativeOf])
+  /// Not an unknown: equal to this expression (another variable, or one of parameters and time)
+  /// through connections and alias equations (`a.s = s`, `a.s = s0`). The Euler–Lagrange rows are
+  /// derived with the variable itself; the DAE substitutes the alias everywhere.
+  sym::Expr alias = nullptr;
 };
 
 enum class OriginKind {
@@ -51,6 +55,7 @@ enum class OriginKind {
   EulerLagrange,    ///< the Euler–Lagrange row of a coordinate
   Kinematic,        ///< der(q) is the velocity of q
   Constraint,       ///< a holonomic constraint
+  Connection,       ///< the flows of a connection set sum to zero (an unconnected flow is zero)
 };
 
 /// Where a flat equation came from, for diagnostics (Rumoca's practice).
@@ -59,6 +64,7 @@ struct Origin {
   SourceRange range;
   int variable = -1;  ///< EulerLagrange/Kinematic: the coordinate; Constraint: its multiplier
   std::string element;  ///< for array equations: which element, e.g. "[2]"
+  int component = 0;    ///< which component instance wrote it (FlatModel::components; 0 = the model)
 };
 
 /// `residual = 0` (user equations are stored as lhs - rhs).
@@ -96,6 +102,8 @@ struct FlatModel {
   std::vector<std::pair<int, Term>> forces;  ///< (coordinate variable, term)
   std::vector<Equation> constraints;         ///< g(q, t) = 0, origin.range = the statement
   std::vector<Output> outputs;
+  /// The component instances, by path ("m1", "ms[2]", "sys.m1"); [0] is the model itself ("").
+  std::vector<std::string> components;
   Experiment experiment;
   /// The scalar Integer parameters the model uses, as "n = 8": structural (they size arrays), so
   /// fixed in what is compiled from this model (shown by executables' --help).

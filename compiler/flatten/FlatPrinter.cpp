@@ -69,6 +69,7 @@ const char* originKindName(OriginKind k) {
     case OriginKind::EulerLagrange: return "Euler-Lagrange row";
     case OriginKind::Kinematic: return "kinematic";
     case OriginKind::Constraint: return "constraint";
+    case OriginKind::Connection: return "connection";
   }
   return "?";
 }

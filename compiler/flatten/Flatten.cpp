@@ -80,20 +80,36 @@ void Flattener::forEachIteration(const std::vector<Iterator>& its, size_t k, con
   }
 }
 
+// The model's instance tree first (every component, with its modifiers), then each instance's
+// declarations, equations and mechanics, then the connections.
 std::optional<FlatModel> Flattener::run() {
   size_t errorsBefore = diags_.errorCount();
-  out_.name = m_.cls->name;
-  out_.description = m_.cls->description;
-  out_.range = m_.cls->nameRange;
+  const ast::ClassDef& cls = *m_.root->cls;
+  out_.name = cls.name;
+  out_.description = cls.description;
+  out_.range = cls.nameRange;
   addVariable({.role = VarRole::Time, .symbol = ctx_.symbol("time")});
-  for (const auto* d : m_.declarations) guarded([&] { valueOf(*d, d->nameRange); });
-  for (const auto& eq : m_.cls->equations) guarded([&] { lowerEquation(eq, out_.equations, OriginKind::Equation); });
-  for (const auto& eq : m_.cls->initialEquations)
-    guarded([&] { lowerEquation(eq, out_.initialEquations, OriginKind::InitialEquation); });
-  for (const auto& st : m_.cls->mechanics) guarded([&] { lowerMechanics(st); });
+  Instance& root = newInstance(*m_.root, nullptr, nullptr, "");
+  cur_ = &root;
+  guarded([&] { instantiate(root); });
+  for (size_t i = 0; i < instances_.size(); ++i)  // instantiate may not have finished: guarded
+    lowerInstance(instances_[i]);
+  cur_ = &root;
+  if (diags_.errorCount() == errorsBefore) guarded([&] { connectAll(); });
   guarded([&] { lowerExperiment(); });
   if (diags_.errorCount() > errorsBefore) return std::nullopt;
   return std::move(out_);
+}
+
+void Flattener::lowerInstance(Instance& inst) {
+  cur_ = &inst;
+  for (const auto* d : inst.cls->declarations)
+    if (inst.cls->symbols.at(d->name).kind != sema::SymbolKind::Component)
+      guarded([&] { valueOf(inst, *d, d->nameRange); });
+  for (const auto* eq : inst.cls->equations) guarded([&] { lowerEquation(*eq, out_.equations, OriginKind::Equation); });
+  for (const auto* eq : inst.cls->initialEquations)
+    guarded([&] { lowerEquation(*eq, out_.initialEquations, OriginKind::InitialEquation); });
+  for (const auto* st : inst.cls->mechanics) guarded([&] { lowerMechanics(*st); });
 }
 
 void Flattener::countScalars(size_t n, SourceRange r) {
@@ -111,6 +127,8 @@ int Flattener::addVariable(Variable v) {
   if (out_.symbolToVariable.size() <= id) out_.symbolToVariable.resize(id + 1, -1);
   out_.symbolToVariable[id] = index;
   out_.variables.push_back(std::move(v));
+  varOwner_.push_back(cur_);
+  connectorPotential_.push_back(0);
   return index;
 }
 
@@ -145,31 +163,33 @@ int Flattener::derivativeVariable(int var, SourceRange where) {
 // with the side effects in the order) that the recursion had. A use of a pending declaration
 // closes a cycle. (The price: a binding naming k declarations not yet resolved is lowered k + 1
 // times, so a literal array of 10⁴ forward references takes seconds; models name a few.)
-const Value& Flattener::valueOf(const Declaration& d, SourceRange use) {
-  if (auto it = declValues_.find(&d); it != declValues_.end()) return it->second;
-  if (failed_.count(&d)) throw FlattenAbort{};
-  if (inProgress_.count(&d))
-    fail(use, DiagCode::E0312, "the definition of '" + d.name + "' depends on itself",
+const Value& Flattener::valueOf(Instance& inst, const Declaration& d, SourceRange use) {
+  DeclKey key{&inst, &d};
+  if (auto it = declValues_.find(key); it != declValues_.end()) return it->second;
+  if (failed_.count(key)) throw FlattenAbort{};
+  if (inProgress_.count(key))
+    fail(use, DiagCode::E0312, "the definition of '" + inst.prefix() + d.name + "' depends on itself",
          "break the cycle: a definition or parameter cannot refer to itself, directly or through others");
-  if (!pending_.empty()) throw NeedFirst{&d};
-  pending_.push_back(&d);
-  inProgress_.insert(&d);
+  if (!pending_.empty()) throw NeedFirst{key};
+  pending_.push_back(key);
+  inProgress_.insert(key);
   while (!pending_.empty()) resolveInnermost();
-  return declValues_.at(&d);
+  return declValues_.at(key);
 }
 
 void Flattener::resolveInnermost() {
-  const Declaration* d = pending_.back();
+  DeclKey key = pending_.back();
   size_t scalarsBefore = scalars_;  // the retry counts this declaration's scalars again
   try {
-    Value v = createDeclaration(*d, m_.symbols.at(d->name));
-    declValues_.emplace(d, std::move(v));
-    inProgress_.erase(d);
+    ScopeGuard scope(*this, *key.inst);
+    Value v = createDeclaration(*key.decl, key.inst->cls->symbols.at(key.decl->name));
+    declValues_.emplace(key, std::move(v));
+    inProgress_.erase(key);
     pending_.pop_back();
   } catch (const NeedFirst& first) {
     scalars_ = scalarsBefore;
-    pending_.push_back(first.decl);
-    inProgress_.insert(first.decl);
+    pending_.push_back(first.key);
+    inProgress_.insert(first.key);
   } catch (...) {  // an error: every declaration waiting for this one fails with it
     failed_.insert(pending_.begin(), pending_.end());
     pending_.clear();
@@ -193,37 +213,49 @@ std::vector<int> Flattener::evaluateDims(const Declaration& d) {
   return shape;
 }
 
+// The kind a declaration has in this instance: a component's input or unknown that a modifier
+// binds (`Force f(F = 10*sin(time))`) is a definition; a component's unbound input an unknown.
+static SymbolKind kindInInstance(SymbolKind kind, bool root, bool bound) {
+  if (kind == SymbolKind::Input && root) return kind;
+  if (kind == SymbolKind::Input || kind == SymbolKind::Unknown) return bound ? SymbolKind::Definition : SymbolKind::Unknown;
+  return kind;
+}
+
 Value Flattener::createDeclaration(const Declaration& d, const sema::ModelSymbol& s) {
   std::vector<int> shape = evaluateDims(d);
-  switch (s.kind) {
+  bool root = cur_ == &instances_.front();
+  const ModEntry* mod = modifierOf(*cur_, d);
+  SourceRange valueRange = mod && mod->mod->value ? mod->mod->value->range : d.binding ? d.binding->range : d.nameRange;
+  std::string name = cur_->prefix() + d.name;
+  switch (kindInInstance(s.kind, root, mod && mod->mod->value)) {
     case SymbolKind::Constant:
     case SymbolKind::IntegerParameter: {
-      if (auto given = structural_.find(d.name); given != structural_.end()) {
+      if (auto given = structural_.find(d.name); root && given != structural_.end()) {
         QDOT_ASSERT(s.kind == SymbolKind::IntegerParameter && shape.empty(), "a structural value for a non-scalar or non-Integer");
         out_.structuralParameters.push_back(d.name + " = " + std::to_string(given->second));
         return Value::scalar(ctx_.constant(static_cast<double>(given->second)));
       }
       Value v = bindingValue(d, shape);
-      if (s.kind == SymbolKind::IntegerParameter && shape.empty() && v.elems[0]->isConstant() &&
+      if (root && s.kind == SymbolKind::IntegerParameter && shape.empty() && v.elems[0]->isConstant() &&
           std::isfinite(v.elems[0]->value))
         out_.structuralParameters.push_back(d.name + " = " + sym::toString(ctx_, v.elems[0]));
       for (size_t i = 0; i < v.size(); ++i)
         if (!v.elems[i]->isConstant())
-          fail(d.binding->range, DiagCode::E0313, "the value of '" + d.name + "' must be known at compile time",
+          fail(valueRange, DiagCode::E0313, "the value of '" + name + "' must be known at compile time",
                "constants and Integer parameters may only depend on literals and other constants");
         else if (!std::isfinite(v.elems[i]->value))  // here, where it is folded: later it is only an `inf` in an equation
-          fail(d.binding->range, DiagCode::E0314,
-               "the value of '" + d.name + "' is not a finite number (it evaluates to " +
+          fail(valueRange, DiagCode::E0314,
+               "the value of '" + name + "' is not a finite number (it evaluates to " +
                    sym::toString(ctx_, v.elems[i]) + ")",
                "look for a division by zero or an overflow in this expression");
         else if (s.kind == SymbolKind::IntegerParameter && v.elems[i]->value != std::floor(v.elems[i]->value))
-          fail(d.binding->range, DiagCode::E0313, "Integer parameter '" + d.name + "' has a non-integer value");
+          fail(valueRange, DiagCode::E0313, "Integer parameter '" + name + "' has a non-integer value");
       return v;
     }
     case SymbolKind::Definition: {
       Value v = bindingValue(d, shape);
       if (d.causality == Causality::Output) {
-        std::vector<std::string> names = scalarNames(d.name, shape);
+        std::vector<std::string> names = scalarNames(name, shape);
         for (size_t i = 0; i < v.size(); ++i) out_.outputs.push_back({names[i], v.elems[i], d.nameRange});
       }
       return v;
@@ -246,16 +278,23 @@ Value Flattener::createDeclaration(const Declaration& d, const sema::ModelSymbol
     }
     case SymbolKind::Coordinate:
     case SymbolKind::Unknown: {
-      bool coord = s.kind == SymbolKind::Coordinate;
+      // A connector potential that the component's energies use is one of its coordinates.
+      bool promoted = std::find(cur_->promoted.begin(), cur_->promoted.end(), d.name) != cur_->promoted.end();
+      bool coord = s.kind == SymbolKind::Coordinate || promoted;
       Value vars = variablesFor(d, shape, coord ? VarRole::Coordinate : VarRole::Unknown);
-      for (Expr x : vars.elems) out_.variables[out_.variableOf(x)].fixed = coord;
+      for (Expr x : vars.elems) {
+        int var = out_.variableOf(x);
+        out_.variables[var].fixed = coord && !promoted;
+        connectorPotential_[var] = cur_->cls->isConnector() && !d.isFlow;
+      }
       if (coord)  // every coordinate has a velocity and an acceleration, used or not
         for (Expr x : vars.elems) derivativeVariable(derivativeVariable(out_.variableOf(x), d.nameRange), d.nameRange);
       applyAttributes(d, vars);
       return vars;
     }
+    case SymbolKind::Component: break;
   }
-  QDOT_UNREACHABLE("createDeclaration: every symbol kind is handled in the switch");
+  QDOT_UNREACHABLE("createDeclaration: components are instances, not values");
 }
 
 // Room for `count` more variables, growing geometrically (reserving exactly per declaration would
@@ -267,9 +306,10 @@ void Flattener::reserveVariables(size_t count) {
 
 // Once per declaration: lowering it again after a dependency was resolved finds them here.
 Value Flattener::variablesFor(const Declaration& d, const std::vector<int>& shape, VarRole role) {
-  if (auto it = declVariables_.find(&d); it != declVariables_.end()) return it->second;
+  DeclKey key{cur_, &d};
+  if (auto it = declVariables_.find(key); it != declVariables_.end()) return it->second;
   Value v{shape, {}};
-  std::vector<std::string> names = scalarNames(d.name, shape);
+  std::vector<std::string> names = scalarNames(cur_->prefix() + d.name, shape);
   // a coordinate brings its velocity and acceleration
   reserveVariables(role == VarRole::Coordinate ? 3 * names.size() : names.size());
   v.elems.reserve(names.size());
@@ -278,7 +318,7 @@ Value Flattener::variablesFor(const Declaration& d, const std::vector<int>& shap
     addVariable({.role = role, .symbol = symbol, .declRange = d.nameRange, .description = d.description});
     v.elems.push_back(symbol);
   }
-  return declVariables_.emplace(&d, std::move(v)).first->second;
+  return declVariables_.emplace(key, std::move(v)).first->second;
 }
 
 void Flattener::checkShape(const Value& v, const std::vector<int>& shape, SourceRange r, const std::string& what) {
@@ -287,15 +327,37 @@ void Flattener::checkShape(const Value& v, const std::vector<int>& shape, Source
          shape.empty() ? "give a scalar value" : "give an array of shape " + shapeText(shape) + ", e.g. with fill(value, ...)");
 }
 
+// The value a modifier gives (`Mass m1(m = 2)`, `extends Base(k = 1)`), else the declaration's own.
 Value Flattener::bindingValue(const Declaration& d, const std::vector<int>& shape) {
+  std::string name = cur_->prefix() + d.name;
+  if (const ModEntry* mod = modifierOf(*cur_, d); mod && mod->mod->value) {
+    Value v = modifierValue(*mod, mod->mod->value->range);
+    checkShape(v, shape, mod->mod->value->range, "the value of '" + name + "'");
+    return v;
+  }
+  if (!d.binding) {
+    SourceRange where = cur_->decl ? cur_->decl->nameRange : d.nameRange;
+    fail(where, DiagCode::E0207, "parameter '" + name + "' has no value",
+         "give it one with a modifier: " + (cur_->decl ? cur_->decl->typeName.back() : std::string("M")) + " " +
+             (cur_->decl ? cur_->decl->name : std::string("c")) + "(" + d.name + " = ...);");
+  }
   Value v = lower(*d.binding);
-  checkShape(v, shape, d.binding->range, "the value of '" + d.name + "'");
+  checkShape(v, shape, d.binding->range, "the value of '" + name + "'");
   return v;
 }
 
 // start/fixed/nominal/min/max/unit; a scalar value applies to every element of an array.
 void Flattener::applyAttributes(const Declaration& d, const Value& vars) {
-  for (const auto& mod : d.mods) {
+  applyAttributeList(d.mods, d, vars);
+  if (const ModEntry* outer = modifierOf(*cur_, d); outer && !outer->mod->nested.empty()) {
+    ScopeGuard scope(*this, *outer->scope);  // `Mass m1(s(start = 0.1))`: written where m1 is declared
+    applyAttributeList(outer->mod->nested, d, vars, outer);
+  }
+}
+
+void Flattener::applyAttributeList(const std::vector<ast::Modification>& mods, const Declaration& d, const Value& vars,
+                                   const ModEntry* outer) {
+  for (const auto& mod : mods) {
     if (!mod.value) continue;
     if (mod.name == "unit") {
       if (auto* s = dyn_cast<StringExpr>(mod.value.get()))
@@ -305,6 +367,7 @@ void Flattener::applyAttributes(const Declaration& d, const Value& vars) {
     if (mod.name != "start" && mod.name != "fixed" && mod.name != "nominal" && mod.name != "min" && mod.name != "max")
       continue;
     Value v = lower(*mod.value);
+    if (outer) v = elementOf(*outer, std::move(v));
     if (!v.isScalar()) checkShape(v, vars.shape, mod.value->range, "the " + mod.name + " value of '" + d.name + "'");
     for (size_t i = 0; i < vars.size(); ++i) {
       Variable& var = out_.variables[out_.variableOf(vars.elems[i])];
@@ -326,6 +389,7 @@ void Flattener::lowerEquation(const ast::Equation& eq, std::vector<flat::Equatio
     });
     return;
   }
+  if (eq.kind == EquationKind::Connect && kind == OriginKind::Equation && eq.lhs && eq.rhs) return lowerConnect(eq);
   if (eq.kind != EquationKind::Simple || !eq.lhs || !eq.rhs) return;  // sema reported the others
   Value l = lower(*eq.lhs);
   Value r = lower(*eq.rhs);
@@ -335,7 +399,8 @@ void Flattener::lowerEquation(const ast::Equation& eq, std::vector<flat::Equatio
   countScalars(l.size(), eq.range);
   for (size_t i = 0; i < l.size(); ++i) {
     std::string element = l.isScalar() ? "" : "[" + std::to_string(i + 1) + "]";
-    into.push_back({ctx_.sub(l.elems[i], r.elems[i]), {kind, eq.range, -1, element}, l.elems[i], r.elems[i]});
+    into.push_back({ctx_.sub(l.elems[i], r.elems[i]), {kind, eq.range, -1, element, cur_->index}, l.elems[i], r.elems[i]});
+    if (kind == OriginKind::Equation) recordAlias(into.size() - 1);
   }
 }
 
@@ -382,7 +447,7 @@ void Flattener::lowerForce(const MechanicsStmt& st) {
 }
 
 void Flattener::lowerExperiment() {
-  for (const auto& ann : m_.cls->annotations)
+  for (const auto& ann : m_.root->cls->annotations)
     for (const auto& mod : ann.mods) {
       if (mod.name != "experiment") continue;
       for (const auto& m : mod.nested) {

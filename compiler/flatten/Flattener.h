@@ -2,8 +2,10 @@
 // (AST expressions to arrays of symbolic expressions). Not part of the stage's interface.
 #pragma once
 
+#include <deque>
 #include <functional>
 #include <initializer_list>
+#include <map>
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
@@ -84,9 +86,65 @@ std::string shapeText(const std::vector<int>& shape);
 /// Thrown after an error has been reported, to abandon the current statement and go on with the next.
 struct FlattenAbort {};
 
-/// Thrown while lowering a declaration that uses `decl`, not yet resolved: resolve that one first.
+struct Instance;
+
+/// A modification that applies to an instance's elements (`Mass m1(m = 2, s(start = 0.1))`),
+/// with the instance whose scope its values are written in.
+struct ModEntry {
+  const ast::Modification* mod = nullptr;
+  Instance* scope = nullptr;
+  int element = -1;         ///< for an array of components: this element (row-major) ...
+  std::vector<int> shape;   ///< ... of an array of this shape: an array value gives one element each
+};
+
+/// The instances of one component declaration (one, or an array of them).
+struct ComponentArray {
+  std::vector<int> shape;
+  std::vector<Instance*> elems;
+};
+
+/// One instance of a class: the model compiled, or a component inside it (`m1`, `ms[2]`, `m1.a`).
+/// Its variables are named by its path (`ms[2].s`).
+struct Instance {
+  const sema::CheckedClass* cls = nullptr;
+  Instance* parent = nullptr;
+  const ast::Declaration* decl = nullptr;  ///< the component declaration (null for the model)
+  std::string path;                        ///< "ms[2]"; "" for the model
+  int index = 0;                           ///< in FlatModel::components
+  std::vector<ModEntry> mods;              ///< outer modifications first (they win)
+  std::vector<std::string> promoted;       ///< a connector's potentials that are coordinates
+  std::unordered_map<const ast::Declaration*, ComponentArray> children;
+  std::vector<std::pair<int, int>> aliasPairs;  ///< its equations `x = y` between variables
+
+  std::string prefix() const { return path.empty() ? "" : path + "."; }
+};
+
+/// A declaration of one instance: what the work list of definitions resolves.
+struct DeclKey {
+  Instance* inst = nullptr;
+  const ast::Declaration* decl = nullptr;
+  bool operator==(const DeclKey& o) const { return inst == o.inst && decl == o.decl; }
+};
+struct DeclKeyHash {
+  size_t operator()(const DeclKey& k) const {
+    return std::hash<const void*>()(k.inst) * 31 + std::hash<const void*>()(k.decl);
+  }
+};
+
+/// Thrown while lowering a declaration that uses `key`, not yet resolved: resolve that one first.
 struct NeedFirst {
-  const ast::Declaration* decl;
+  DeclKey key;
+};
+
+/// One `connect(a, b)`: the two connector instances, each inside (a component's connector) or
+/// outside (the connector of the instance whose equation it is).
+struct ConnectorEnd {
+  Instance* connector = nullptr;
+  bool outside = false;
+};
+struct Connection {
+  ConnectorEnd a, b;
+  SourceRange range;
 };
 
 class Flattener {
@@ -118,22 +176,58 @@ class Flattener {
   sym::DirectionalDerivative timeDerivative_{ctx_};  ///< der(): memo shared by all calls
   SourceRange derivativeSite_;                       ///< the der() being expanded (for E0311)
 
-  std::unordered_map<const ast::Declaration*, Value> declValues_;
-  std::unordered_map<const ast::Declaration*, Value> declVariables_;  ///< a declaration's variables, made once
-  std::vector<const ast::Declaration*> pending_;  ///< declarations waiting for one another, innermost last
-  std::unordered_set<const ast::Declaration*> inProgress_;  ///< the same, to find a cycle quickly
-  std::unordered_set<const ast::Declaration*> failed_;  ///< already reported; later uses abort quietly
+  std::deque<Instance> instances_;  ///< [0] is the model; then components in creation order
+  Instance* cur_ = nullptr;         ///< whose names the expressions being lowered use
+  std::unordered_map<DeclKey, Value, DeclKeyHash> declValues_;
+  std::unordered_map<DeclKey, Value, DeclKeyHash> declVariables_;  ///< a declaration's variables, made once
+  std::vector<DeclKey> pending_;  ///< declarations waiting for one another, innermost last
+  std::unordered_set<DeclKey, DeclKeyHash> inProgress_;  ///< the same, to find a cycle quickly
+  std::unordered_set<DeclKey, DeclKeyHash> failed_;  ///< already reported; later uses abort quietly
+  std::map<std::pair<const ast::Modification*, Instance*>, Value> modValues_;  ///< each modifier lowered once
+  std::map<std::pair<const ast::Modification*, const Instance*>, ModEntry> extendsEntries_;
+  std::vector<Instance*> varOwner_;       ///< by variable: the instance that declared it
+  std::vector<char> connectorPotential_;  ///< by variable: a potential of a connector
+  std::vector<Connection> connections_;
+  std::vector<size_t> aliasCandidates_;   ///< equations `potential = variable or known expression`
   std::vector<std::pair<std::string, sym::Expr>> iterators_;  ///< innermost last
   std::vector<std::pair<const Value*, int>> endContext_;      ///< (array, dimension) being subscripted, for `end`
 
   // Flatten.cpp
-  const Value& valueOf(const ast::Declaration& d, SourceRange use);
+  const Value& valueOf(Instance& inst, const ast::Declaration& d, SourceRange use);
   void resolveInnermost();
   Value createDeclaration(const ast::Declaration& d, const sema::ModelSymbol& s);
   std::vector<int> evaluateDims(const ast::Declaration& d);
   Value variablesFor(const ast::Declaration& d, const std::vector<int>& shape, VarRole role);
   void applyAttributes(const ast::Declaration& d, const Value& vars);
+  void applyAttributeList(const std::vector<ast::Modification>& mods, const ast::Declaration& d, const Value& vars,
+                          const ModEntry* outer = nullptr);
   Value bindingValue(const ast::Declaration& d, const std::vector<int>& shape);
+  bool hasBinding(const ast::Declaration& d);
+  void lowerInstance(Instance& inst);
+
+  // Instances.cpp
+  class ScopeGuard;
+  Instance& newInstance(const sema::CheckedClass& cls, Instance* parent, const ast::Declaration* decl, std::string path);
+  void instantiate(Instance& inst);
+  const ModEntry* modifierOf(const Instance& inst, const ast::Declaration& d);
+  Value modifierValue(const ModEntry& entry, SourceRange where);
+  static Value elementOf(const ModEntry& entry, Value v);
+  const sema::ModelSymbol& symbolIn(const Instance& inst, const std::string& name, SourceRange where);
+  Instance& instanceOf(const ast::Expr& e);
+  const ComponentArray& componentArrayOf(const ast::Expr& e);
+  const ComponentArray& childArray(Instance& inst, const std::string& name, SourceRange where);
+  Value lowerMember(const ast::MemberExpr& e);
+  Value lowerDotted(const ast::NameExpr& n);
+
+  // Connections.cpp
+  void lowerConnect(const ast::Equation& eq);
+  void recordAlias(size_t equation);
+  void connectAll();
+  void addFlowBalances(const std::vector<std::vector<ConnectorEnd>>& sets, const std::vector<SourceRange>& ranges);
+  void eliminateAliases(const std::vector<std::vector<ConnectorEnd>>& sets, const std::vector<SourceRange>& ranges);
+  void setAlias(int var, sym::Expr value, SourceRange where);
+  void attachFlows();
+  int coordinateOfPotential(const Instance& inst, int x);
   int addVariable(Variable v);
   void reserveVariables(size_t count);
   int derivativeVariable(int var, SourceRange where);
@@ -171,6 +265,32 @@ class Flattener {
   Value mapUnary(const Value& v, sym::Kind k);
 
   friend struct IteratorScope;
+  friend class ScopeGuard;
+};
+
+// Lowering in another instance's scope (a declaration resolved from anywhere, a modifier written
+// in the enclosing model): its names, no loop iterators, no `end` context; restored on exit.
+class Flattener::ScopeGuard {
+ public:
+  ScopeGuard(Flattener& f, Instance& inst)
+      : f_(f), cur_(f.cur_), iterators_(std::move(f.iterators_)), end_(std::move(f.endContext_)) {
+    f_.cur_ = &inst;
+    f_.iterators_.clear();
+    f_.endContext_.clear();
+  }
+  ~ScopeGuard() {
+    f_.cur_ = cur_;
+    f_.iterators_ = std::move(iterators_);
+    f_.endContext_ = std::move(end_);
+  }
+  ScopeGuard(const ScopeGuard&) = delete;
+  ScopeGuard& operator=(const ScopeGuard&) = delete;
+
+ private:
+  Flattener& f_;
+  Instance* cur_;
+  std::vector<std::pair<std::string, sym::Expr>> iterators_;
+  std::vector<std::pair<const Value*, int>> end_;
 };
 
 }  // namespace qdot::flat

@@ -91,6 +91,7 @@ class Builder {
         return label + " (Euler-Lagrange equation of " + variableNameOfFlat(e.origin.variable) + ")";
       case flat::OriginKind::Kinematic: return label + " (velocity of " + variableNameOfFlat(e.origin.variable) + ")";
       case flat::OriginKind::Constraint: return label + " (constraint" + e.origin.element + ")";
+      case flat::OriginKind::Connection: return label + " (flow balance of the connection " + e.origin.element + ")";
       case flat::OriginKind::Equation:
       case flat::OriginKind::InitialEquation: break;
     }

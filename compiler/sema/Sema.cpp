@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <functional>
+#include <unordered_set>
+
+#include "sema/ClassLookup.h"
 
 namespace qdot::sema {
 namespace {
@@ -24,80 +27,226 @@ bool isEventFunction(std::string_view n) {
   return n == "pre" || n == "reinit" || n == "initial" || n == "edge" || n == "sample" || n == "change";
 }
 
-std::string typeNameOf(const Declaration& d) {
+std::string dottedName(const std::vector<std::string>& parts) {
   std::string s;
-  for (size_t i = 0; i < d.typeName.size(); ++i) s += (i ? "." : "") + d.typeName[i];
+  for (size_t i = 0; i < parts.size(); ++i) s += (i ? "." : "") + parts[i];
   return s;
 }
 
-/// Walks one model: declarations first (scope), then every expression with iterator scopes.
-class Checker {
+std::optional<BaseType> builtinType(const std::string& t) {
+  if (t == "Real") return BaseType::Real;
+  if (t == "Integer") return BaseType::Integer;
+  if (t == "Boolean") return BaseType::Boolean;
+  return std::nullopt;
+}
+
+class ClassChecker;
+
+/// Checks the model compiled and, on first use, every class its components use (each once).
+class ModelChecker {
  public:
-  Checker(CheckedModel& m, DiagnosticEngine& diags) : m_(m), diags_(diags) {}
+  ModelChecker(const StoredDefinition& file, DiagnosticEngine& diags, const Library& library, CheckedModel& out)
+      : lookup_(file, library), diags_(diags), library_(library), out_(out) {}
+
+  /// The checked class, or null while it is being checked (a class that contains itself).
+  const CheckedClass* check(const ClassDef& cls, bool root = false);
+  ClassLookup& lookup() { return lookup_; }
+  DiagnosticEngine& diags() { return diags_; }
+  const Library& library() const { return library_; }
+
+ private:
+  ClassLookup lookup_;
+  DiagnosticEngine& diags_;
+  const Library& library_;
+  CheckedModel& out_;
+  std::unordered_map<const ClassDef*, const CheckedClass*> done_;
+  std::unordered_set<const ClassDef*> inProgress_;
+};
+
+/// Walks one class: what it inherits, its declarations (scope), then every expression with
+/// iterator scopes, every modifier against the class it modifies, every connect.
+class ClassChecker {
+ public:
+  ClassChecker(ModelChecker& model, CheckedClass& c, bool root)
+      : model_(model), c_(c), diags_(model.diags()), root_(root) {}
 
   void run() {
-    for (const auto& d : m_.cls->declarations) declare(d);
-    for (const auto& e : m_.cls->extends)
-      diags_.error(e.range, DiagCode::E0290, "'extends' is not supported yet",
-                   "inline the base model: copy its declarations and equations into this model");
-    for (const auto* d : m_.declarations) checkDeclaration(*d);
-    for (const auto& eq : m_.cls->equations) checkEquation(eq);
-    for (const auto& eq : m_.cls->initialEquations) checkEquation(eq);
-    for (const auto& st : m_.cls->mechanics) checkMechanics(st);
+    for (const auto& e : c_.cls->extends) inherit(e);
+    for (const auto& d : c_.cls->declarations) declare(d);
+    for (const auto& d : c_.cls->declarations) checkDeclaration(d);
+    for (const auto& e : c_.cls->extends) checkExtendsModifiers(e);
+    for (const auto& eq : c_.cls->equations) {
+      c_.equations.push_back(&eq);
+      checkEquation(eq);
+    }
+    for (const auto& eq : c_.cls->initialEquations) {
+      c_.initialEquations.push_back(&eq);
+      checkEquation(eq);
+    }
+    inMechanics_ = true;
+    for (const auto& st : c_.cls->mechanics) {
+      c_.mechanics.push_back(&st);
+      checkMechanics(st);
+    }
+    inMechanics_ = false;
   }
 
  private:
-  CheckedModel& m_;
+  ModelChecker& model_;
+  CheckedClass& c_;
   DiagnosticEngine& diags_;
+  bool root_;  ///< the model compiled (a component's parameters may get their values from modifiers)
   std::vector<std::string> iterators_;
+  bool inMechanics_ = false;
+  bool componentAllowed_ = false;  ///< inside connect(...): references may name connectors
+  std::unordered_map<const ExtendsClause*, const CheckedClass*> bases_;
 
-  void declare(const Declaration& d) {
-    auto [it, inserted] = m_.symbols.try_emplace(d.name);
+  // --- classes ---------------------------------------------------------------------------------
+
+  /// The class a type name means here, reporting an unknown one (with the search path).
+  const ClassDef* resolveClass(const std::vector<std::string>& parts, SourceRange where) {
+    if (const ClassDef* cls = model_.lookup().resolve(parts, c_.cls)) return cls;
+    std::string name = dottedName(parts);
+    const std::string& path = model_.library().searchPath;
+    diags_.error(where, DiagCode::E0220, "unknown class '" + name + "'",
+                 path.empty() ? "declare it in this file, or check the spelling"
+                              : "declare it in this file, import it (import Vibration.*;), or put its package on the "
+                                "library path; searched: " + path);
+    return nullptr;
+  }
+
+  const CheckedClass* checkedClass(const ClassDef& cls, SourceRange where, const std::string& via) {
+    const CheckedClass* checked = model_.check(cls);
+    if (!checked)
+      diags_.error(where, DiagCode::E0223,
+                   "class '" + model_.lookup().fullName(&cls) + "' contains itself (through " + via + ")",
+                   "a component cannot contain an instance of its own class, directly or through others");
+    return checked;
+  }
+
+  void inherit(const ExtendsClause& e) {
+    if (builtinType(dottedName(e.baseName))) return;  // type Length = Real(unit = "m")
+    const ClassDef* base = resolveClass(e.baseName, e.range);
+    if (!base) return;
+    const CheckedClass* b = checkedClass(*base, e.range, "extends " + dottedName(e.baseName));
+    if (!b) return;
+    bases_[&e] = b;
+    for (const Declaration* d : b->declarations) addSymbol(*d, b->symbols.at(d->name));
+    c_.equations.insert(c_.equations.end(), b->equations.begin(), b->equations.end());
+    c_.initialEquations.insert(c_.initialEquations.end(), b->initialEquations.begin(), b->initialEquations.end());
+    c_.mechanics.insert(c_.mechanics.end(), b->mechanics.begin(), b->mechanics.end());
+    c_.extendsModifiers.insert(b->extendsModifiers.begin(), b->extendsModifiers.end());
+    for (const auto& p : b->energyPotentials) addEnergyPotential(p);
+  }
+
+  // `extends Base(k = 1)`: each name an element of Base, values checked here.
+  void checkExtendsModifiers(const ExtendsClause& e) {
+    auto it = bases_.find(&e);
+    if (it == bases_.end()) return;
+    for (const auto& mod : e.mods) {
+      const ModelSymbol* s = checkModifier(mod, *it->second);
+      if (s && s->kind != SymbolKind::Component) c_.extendsModifiers[s->decl] = &mod;
+    }
+  }
+
+  // --- declarations ----------------------------------------------------------------------------
+
+  bool addSymbol(const Declaration& d, const ModelSymbol& s) {
+    auto [it, inserted] = c_.symbols.try_emplace(d.name, s);
     if (!inserted) {
       auto& diag = diags_.error(d.nameRange, DiagCode::E0201, "'" + d.name + "' is declared twice",
                                 "rename one of the two declarations");
       diag.notes.push_back({it->second.decl->nameRange, "first declared here"});
-      return;
+      return false;
     }
-    ModelSymbol& s = it->second;
+    c_.declarations.push_back(&d);
+    return true;
+  }
+
+  void declare(const Declaration& d) {
+    ModelSymbol s;
     s.decl = &d;
-    std::string t = typeNameOf(d);
-    s.type = t == "Integer" ? BaseType::Integer : t == "Boolean" ? BaseType::Boolean : BaseType::Real;
-    if (d.variability == Variability::Constant) s.kind = SymbolKind::Constant;
-    else if (d.causality == Causality::Input && !d.binding && d.variability == Variability::Continuous &&
-             s.type == BaseType::Real && !d.isCoordinate)
-      s.kind = SymbolKind::Input;
-    else if (d.variability == Variability::Parameter)
+    std::string t = dottedName(d.typeName);
+    std::optional<BaseType> builtin = builtinType(t);
+    const ClassDef* cls = builtin ? nullptr : resolveClass(d.typeName, d.typeRange);
+    if (cls && cls->kind == ClassKind::Type) {  // type Length = Real(...): a Real
+      builtin = BaseType::Real;
+      for (const auto& e : cls->extends) builtin = builtinType(dottedName(e.baseName)).value_or(BaseType::Real);
+      cls = nullptr;
+    }
+    s.type = builtin.value_or(BaseType::Real);
+    if (!builtin) {
+      s.kind = SymbolKind::Component;
+      if (cls) s.component = checkedClass(*cls, d.typeRange, "component '" + d.name + "'");
+    } else if (d.variability == Variability::Constant) {
+      s.kind = SymbolKind::Constant;
+    } else if (d.variability == Variability::Parameter) {
       s.kind = s.type == BaseType::Integer ? SymbolKind::IntegerParameter : SymbolKind::Parameter;
-    else if (d.isCoordinate) s.kind = SymbolKind::Coordinate;
-    else if (d.binding) s.kind = SymbolKind::Definition;
-    else s.kind = SymbolKind::Unknown;
-    m_.declarations.push_back(&d);
+    } else if (d.causality == Causality::Input && !d.binding && s.type == BaseType::Real && !d.isCoordinate) {
+      s.kind = SymbolKind::Input;
+    } else if (d.isCoordinate) {
+      s.kind = SymbolKind::Coordinate;
+    } else if (d.binding) {
+      s.kind = SymbolKind::Definition;
+    } else {
+      s.kind = SymbolKind::Unknown;
+    }
+    addSymbol(d, s);
   }
 
   void checkDeclaration(const Declaration& d) {
-    const ModelSymbol& s = m_.symbols.at(d.name);
+    const ModelSymbol& s = c_.symbols.at(d.name);
     if (s.decl != &d) return;  // duplicate, already reported
-    if (!checkType(d)) return;
     for (const auto& dim : d.typeDims) checkSize(*dim);
     for (const auto& dim : d.dims) checkSize(*dim);
+    if (s.kind == SymbolKind::Component) return checkComponentDeclaration(d, s);
     for (const auto& mod : d.mods) checkModification(d, mod);
     if (d.binding) checkExpr(*d.binding);
     checkKindRules(d, s);
   }
 
-  bool checkType(const Declaration& d) {
-    std::string t = typeNameOf(d);
-    if (t == "Real" || t == "Integer" || t == "Boolean") return true;
-    diags_.error(d.typeRange, DiagCode::E0290, "component type '" + t + "' is not supported yet",
-                 "write the component's equations in this model instead, with Real, Integer or Boolean variables");
-    return false;
+  void checkComponentDeclaration(const Declaration& d, const ModelSymbol& s) {
+    if (d.binding)
+      diags_.error(d.binding->range, DiagCode::E0224, "component '" + d.name + "' cannot have a value",
+                   "set its parameters with a modifier instead: " + dottedName(d.typeName) + " " + d.name + "(k = 1);");
+    if (d.isCoordinate || d.variability != Variability::Continuous || d.isFlow)
+      diags_.error(d.range, DiagCode::E0206, "component '" + d.name + "' cannot be a coordinate, parameter, constant or flow",
+                   "remove the prefix: these apply to Real variables");
+    if (!s.component) return;
+    for (const auto& mod : d.mods) checkModifier(mod, *s.component);
+  }
+
+  // A modifier `name = value` or `name(nested...)` of an element of `target`; its value is an
+  // expression of this class. Returns the element, or null after reporting.
+  const ModelSymbol* checkModifier(const Modification& mod, const CheckedClass& target) {
+    const ModelSymbol* s = target.find(mod.name);
+    if (!s) {
+      std::vector<std::string> names;
+      for (const Declaration* d : target.declarations) names.push_back(d->name);
+      std::string guess = closestName(mod.name, names);
+      std::string list;
+      for (size_t i = 0; i < names.size() && i < 12; ++i) list += (i ? ", " : "") + names[i];
+      diags_.error(mod.nameRange, DiagCode::E0221, "'" + target.fullName + "' has no element '" + mod.name + "'",
+                   guess.empty() ? "its elements are: " + list : "did you mean '" + guess + "'?");
+      return nullptr;
+    }
+    if (s->kind == SymbolKind::Component) {
+      if (mod.value)
+        diags_.error(mod.value->range, DiagCode::E0224, "'" + mod.name + "' is a component and cannot be given a value",
+                     "modify its elements instead: " + mod.name + "(name = value)");
+      if (s->component)
+        for (const auto& n : mod.nested) checkModifier(n, *s->component);
+      return s;
+    }
+    if (mod.value) checkExpr(*mod.value);
+    for (const auto& n : mod.nested) checkModification(*s->decl, n);
+    return s;
   }
 
   void checkKindRules(const Declaration& d, const ModelSymbol& s) {
-    if (d.isFlow)
-      diags_.error(d.range, DiagCode::E0290, "'flow' variables are not supported yet",
-                   "declare a plain Real and write the balance equation yourself, e.g. i1 + i2 = 0;");
+    if (d.isFlow && !c_.isConnector())
+      diags_.error(d.range, DiagCode::E0290, "'flow' variables belong in connectors",
+                   "declare '" + d.name + "' in a connector class (connector Flange Real s; flow Real f; end Flange;)");
     if (d.causality == Causality::Input && d.isCoordinate)
       diags_.error(d.range, DiagCode::E0206, "a coordinate cannot be an input",
                    "remove 'input', or declare a plain 'input Real' and use it in a force");
@@ -110,11 +259,13 @@ class Checker {
     if (d.isCoordinate && d.variability != Variability::Continuous)
       diags_.error(d.range, DiagCode::E0206, "a coordinate cannot be a parameter or constant",
                    "remove 'parameter'/'constant' from the declaration of '" + d.name + "'");
+    // A component's parameter may get its value from a modifier (Mass m1(m = 2)); the model
+    // compiled must give every one (checked when it is instantiated, by flatten).
     if ((s.kind == SymbolKind::Constant || s.kind == SymbolKind::IntegerParameter ||
-         s.kind == SymbolKind::Parameter) && !d.binding)
+         s.kind == SymbolKind::Parameter) && !d.binding && root_)
       diags_.error(d.nameRange, DiagCode::E0207, "parameter '" + d.name + "' has no value",
                    "give it a default value, e.g. parameter Real " + d.name + " = 1;");
-    if (s.kind == SymbolKind::Unknown && s.type != BaseType::Real)
+    if ((s.kind == SymbolKind::Unknown || s.kind == SymbolKind::Input) && s.type != BaseType::Real)
       diags_.error(d.typeRange, DiagCode::E0205, "time-varying variable '" + d.name + "' must be of type Real",
                    "make it a parameter, or declare it Real");
   }
@@ -143,13 +294,13 @@ class Checker {
   bool isIntegerExpr(const Expr& e, std::string& why) {
     if (auto* n = dyn_cast<NumberExpr>(&e)) return n->isInteger;
     if (auto* n = dyn_cast<NameExpr>(&e)) {
-      if (n->parts.size() != 1) return false;
-      if (std::find(iterators_.begin(), iterators_.end(), n->parts[0]) != iterators_.end()) return true;
-      auto it = m_.symbols.find(n->parts[0]);
-      if (it == m_.symbols.end()) return true;  // already reported as unknown
-      bool ok = it->second.type == BaseType::Integer &&
-                (it->second.kind == SymbolKind::IntegerParameter || it->second.kind == SymbolKind::Constant);
-      if (!ok) why = "; '" + n->parts[0] + "' is not an Integer parameter or constant";
+      if (n->parts.size() == 1 && std::find(iterators_.begin(), iterators_.end(), n->parts[0]) != iterators_.end())
+        return true;
+      const ModelSymbol* s = lookupQuietly(n->parts);
+      if (!s) return true;  // already reported as unknown
+      bool ok = s->type == BaseType::Integer &&
+                (s->kind == SymbolKind::IntegerParameter || s->kind == SymbolKind::Constant);
+      if (!ok) why = "; '" + n->dotted() + "' is not an Integer parameter or constant";
       return ok;
     }
     if (auto* u = dyn_cast<UnaryExpr>(&e)) return u->op != UnaryOp::Not && isIntegerExpr(*u->operand, why);
@@ -160,6 +311,8 @@ class Checker {
     return false;
   }
 
+  // --- equations and mechanics -----------------------------------------------------------------
+
   void checkEquation(const Equation& eq) {
     switch (eq.kind) {
       case EquationKind::Simple:
@@ -169,11 +322,7 @@ class Checker {
       case EquationKind::For:
         withIterators(eq.iterators, [&] { for (const auto& b : eq.body) checkEquation(b); });
         return;
-      case EquationKind::Connect:
-        diags_.error(eq.range, DiagCode::E0290, "'connect' is not supported yet",
-                     "write the equations the connection stands for: equal potentials (v1 = v2;) and flows "
-                     "that sum to zero (i1 + i2 = 0;)");
-        return;
+      case EquationKind::Connect: return checkConnect(eq);
       case EquationKind::When:
         diags_.error(eq.range, DiagCode::E0290, "'when' equations are not supported yet",
                      "for a switch that depends on the state, write an if-expression: f = if x > 0 then -k*x else 0;");
@@ -183,6 +332,49 @@ class Checker {
                      "write the equation with an if-expression: x = if c then a else b;");
         return;
     }
+  }
+
+  void checkConnect(const Equation& eq) {
+    if (!eq.lhs || !eq.rhs) return;
+    size_t errors = diags_.errorCount();
+    componentAllowed_ = true;
+    checkExpr(*eq.lhs);
+    checkExpr(*eq.rhs);
+    componentAllowed_ = false;
+    if (diags_.errorCount() > errors) return;
+    const CheckedClass* a = connectorOf(*eq.lhs);
+    const CheckedClass* b = connectorOf(*eq.rhs);
+    if (!a || !b || a == b || compatible(*a, *b)) return;
+    diags_.error(eq.range, DiagCode::E0222,
+                 "cannot connect a '" + a->fullName + "' to a '" + b->fullName + "'",
+                 "connect connectors of the same kind (their variables and flows must match)");
+  }
+
+  // The connector class a connect argument names, or null after reporting why it is not one.
+  const CheckedClass* connectorOf(const Expr& e) {
+    const ModelSymbol* s = referenceSymbol(e);
+    if (s && s->kind == SymbolKind::Component && !s->component) return nullptr;  // its class is unknown: reported
+    const CheckedClass* c = referenceClass(e);
+    if (c && c->isConnector()) return c;
+    diags_.error(e.range, DiagCode::E0222,
+                 c ? "connect needs connectors, but this is a '" + c->fullName + "' component"
+                   : "connect needs connectors, but this is a variable",
+                 c ? "connect its connectors, e.g. the flanges a and b of a Vibration element"
+                   : "connect(a, b) joins two connectors; to equate variables write an equation x = y;");
+    return nullptr;
+  }
+
+  // Two connector classes that declare the same variables (names, types, flow prefixes, sizes).
+  static bool compatible(const CheckedClass& a, const CheckedClass& b) {
+    if (a.declarations.size() != b.declarations.size()) return false;
+    for (size_t i = 0; i < a.declarations.size(); ++i) {
+      const Declaration& x = *a.declarations[i];
+      const Declaration& y = *b.declarations[i];
+      if (x.name != y.name || x.isFlow != y.isFlow || x.typeName != y.typeName ||
+          x.dims.size() != y.dims.size())
+        return false;
+    }
+    return true;
   }
 
   void checkMechanics(const MechanicsStmt& st) {
@@ -195,20 +387,34 @@ class Checker {
     if (st.kind == MechanicsKind::Force && st.target) checkForceTarget(*st.target);
   }
 
+  // force(q) acts on a coordinate (also of a component: m1.s, ms[i].s) or on one of this class's
+  // connector potentials (force(a.s)), which then is a coordinate of the component.
   void checkForceTarget(const Expr& target) {
     checkExpr(target);
     const Expr* base = &target;
     if (auto* ix = dyn_cast<IndexExpr>(base)) base = ix->base.get();
-    auto* name = dyn_cast<NameExpr>(base);
-    if (!name || name->parts.size() != 1) {
-      diags_.error(target.range, DiagCode::E0209, "force(...) must name a coordinate",
-                   "write force(q) = expr; or force(q[i]) = expr; with q a coordinate");
+    const ModelSymbol* s = nullptr;
+    if (auto* name = dyn_cast<NameExpr>(base)) s = lookupQuietly(name->parts);
+    else if (auto* m = dyn_cast<MemberExpr>(base))
+      if (const CheckedClass* c = referenceClass(*m->base)) s = c->find(m->field);
+    if (!s) {
+      if (!dyn_cast<NameExpr>(base) && !dyn_cast<MemberExpr>(base))
+        diags_.error(target.range, DiagCode::E0209, "force(...) must name a coordinate",
+                     "write force(q) = expr; or force(q[i]) = expr; with q a coordinate");
       return;
     }
-    auto it = m_.symbols.find(name->parts[0]);
-    if (it != m_.symbols.end() && it->second.kind != SymbolKind::Coordinate)
-      diags_.error(target.range, DiagCode::E0209, "'" + name->parts[0] + "' is not a coordinate",
-                   "generalized forces act on coordinates: declare it 'coordinate Real " + name->parts[0] + "'");
+    bool potential = s->kind == SymbolKind::Unknown && !s->decl->isFlow;
+    if (s->kind != SymbolKind::Coordinate && !potential) {
+      std::string name = sourceText(*base);
+      diags_.error(target.range, DiagCode::E0209, "'" + name + "' is not a coordinate",
+                   "generalized forces act on coordinates: declare it 'coordinate Real " + name + "'");
+    }
+  }
+
+  static std::string sourceText(const Expr& e) {
+    if (auto* n = dyn_cast<NameExpr>(&e)) return n->dotted();
+    if (auto* m = dyn_cast<MemberExpr>(&e)) return "…." + m->field;
+    return "this";
   }
 
   void withIterators(const std::vector<Iterator>& its, const std::function<void()>& body) {
@@ -219,23 +425,98 @@ class Checker {
     iterators_.resize(iterators_.size() - its.size());
   }
 
+  // --- names -----------------------------------------------------------------------------------
+
+  /// The symbol a dotted name ends at (through components), or null; reports nothing.
+  const ModelSymbol* lookupQuietly(const std::vector<std::string>& parts) const {
+    const ModelSymbol* s = c_.find(parts[0]);
+    for (size_t i = 1; s && i < parts.size(); ++i)
+      s = s->kind == SymbolKind::Component && s->component ? s->component->find(parts[i]) : nullptr;
+    return s;
+  }
+
+  /// The declaration an expression ends at (`m1`, `ms[2]`, `sys.m1.a`, `m1.s`), or null.
+  const ModelSymbol* referenceSymbol(const Expr& e) const {
+    if (auto* n = dyn_cast<NameExpr>(&e)) {
+      if (n->parts.size() == 1 && std::find(iterators_.begin(), iterators_.end(), n->parts[0]) != iterators_.end())
+        return nullptr;
+      return lookupQuietly(n->parts);
+    }
+    if (auto* ix = dyn_cast<IndexExpr>(&e)) return referenceSymbol(*ix->base);
+    if (auto* m = dyn_cast<MemberExpr>(&e)) {
+      const CheckedClass* base = referenceClass(*m->base);
+      return base ? base->find(m->field) : nullptr;
+    }
+    return nullptr;
+  }
+
+  /// The class of the component(s) an expression names, or null.
+  const CheckedClass* referenceClass(const Expr& e) const {
+    const ModelSymbol* s = referenceSymbol(e);
+    return s && s->kind == SymbolKind::Component ? s->component : nullptr;
+  }
+
+  void addEnergyPotential(const std::string& p) {
+    if (std::find(c_.energyPotentials.begin(), c_.energyPotentials.end(), p) == c_.energyPotentials.end())
+      c_.energyPotentials.push_back(p);
+  }
+
   void checkName(const NameExpr& n) {
     const std::string& first = n.parts[0];
-    if (n.parts.size() > 1) {
-      diags_.error(n.range, DiagCode::E0290, "dotted name '" + n.dotted() + "' is not supported yet",
-                   "write the component's variables and equations in this model and use their plain names");
+    if (n.parts.size() == 1 && (first == "time" || first == "pi")) return;
+    if (n.parts.size() == 1 && std::find(iterators_.begin(), iterators_.end(), first) != iterators_.end()) return;
+    const ModelSymbol* s = c_.find(first);
+    if (!s) return reportUnknown(n, 0, c_);
+    for (size_t i = 1; i < n.parts.size(); ++i) {
+      if (s->kind != SymbolKind::Component) {
+        diags_.error(n.partRanges[i], DiagCode::E0224,
+                     "'" + dottedPrefix(n, i) + "' is not a component, so it has no element '" + n.parts[i] + "'",
+                     "only components (instances of models and connectors) have elements");
+        return;
+      }
+      if (!s->component) return;  // its class did not resolve: reported
+      const CheckedClass& owner = *s->component;
+      const ModelSymbol* next = owner.find(n.parts[i]);
+      if (!next) return reportUnknown(n, i, owner);
+      if (inMechanics_ && i == 1 && n.parts.size() == 2 && owner.isConnector() && s->decl->dims.empty() &&
+          next->kind == SymbolKind::Unknown && !next->decl->isFlow)
+        addEnergyPotential(n.dotted());
+      s = next;
+    }
+    if (s->kind == SymbolKind::Component && !componentAllowed_)
+      diags_.error(n.range, DiagCode::E0224, "'" + n.dotted() + "' is a component, not a value",
+                   "use one of its variables, e.g. " + n.dotted() + "." + firstVariableOf(s->component));
+  }
+
+  static std::string firstVariableOf(const CheckedClass* c) {
+    if (c)
+      for (const Declaration* d : c->declarations)
+        if (c->symbols.at(d->name).kind != SymbolKind::Component) return d->name;
+    return "x";
+  }
+
+  static std::string dottedPrefix(const NameExpr& n, size_t count) {
+    std::string s;
+    for (size_t i = 0; i < count; ++i) s += (i ? "." : "") + n.parts[i];
+    return s;
+  }
+
+  void reportUnknown(const NameExpr& n, size_t part, const CheckedClass& scope) {
+    const std::string& name = n.parts[part];
+    std::vector<std::string> candidates;
+    if (part == 0) candidates = iterators_;
+    for (const auto& [k, v] : scope.symbols) candidates.push_back(k);
+    std::string guess = closestName(name, candidates);
+    SourceRange where = n.partRanges.size() > part ? n.partRanges[part] : n.range;
+    if (part > 0) {
+      diags_.error(where, DiagCode::E0202, "'" + scope.fullName + "' has no element '" + name + "'",
+                   guess.empty() ? "see the class's declarations" : "did you mean '" + guess + "'?");
       return;
     }
-    if (first == "time" || first == "pi") return;
-    if (std::find(iterators_.begin(), iterators_.end(), first) != iterators_.end()) return;
-    if (m_.symbols.count(first)) return;
-    std::vector<std::string> candidates(iterators_);
-    for (const auto& [k, v] : m_.symbols) candidates.push_back(k);
-    std::string guess = closestName(first, candidates);
-    diags_.error(n.partRanges.empty() ? n.range : n.partRanges[0], DiagCode::E0202, "unknown name '" + first + "'",
-                 isEnergyKeyword(first) ? "'" + first + " = expr;' states an energy: write it in the mechanics section"
-                 : guess.empty()        ? "declare it, e.g. parameter Real " + first + " = 1;"
-                                        : "did you mean '" + guess + "'?");
+    diags_.error(where, DiagCode::E0202, "unknown name '" + name + "'",
+                 isEnergyKeyword(name) ? "'" + name + " = expr;' states an energy: write it in the mechanics section"
+                 : guess.empty()       ? "declare it, e.g. parameter Real " + name + " = 1;"
+                                       : "did you mean '" + guess + "'?");
   }
 
   // The words that start a mechanics statement; written in an equation section they are names.
@@ -243,8 +524,40 @@ class Checker {
     return name == "kinetic" || name == "potential" || name == "dissipation";
   }
 
+  void checkMember(const MemberExpr& m) {
+    bool allowed = componentAllowed_;
+    componentAllowed_ = true;  // the base names a component
+    checkExpr(*m.base);
+    componentAllowed_ = allowed;
+    const CheckedClass* c = referenceClass(*m.base);
+    if (!c) {
+      if (!isa<NameExpr>(m.base.get()) || lookupQuietly(cast<NameExpr>(m.base.get())->parts))
+        diags_.error(m.fieldRange, DiagCode::E0224, "this is not a component, so it has no element '" + m.field + "'",
+                     "only components (instances of models and connectors) have elements");
+      return;
+    }
+    const ModelSymbol* s = c->find(m.field);
+    if (!s) {
+      std::vector<std::string> names;
+      for (const auto& [k, v] : c->symbols) names.push_back(k);
+      std::string guess = closestName(m.field, names);
+      diags_.error(m.fieldRange, DiagCode::E0202, "'" + c->fullName + "' has no element '" + m.field + "'",
+                   guess.empty() ? "see the class's declarations" : "did you mean '" + guess + "'?");
+      return;
+    }
+    if (s->kind == SymbolKind::Component && !componentAllowed_)
+      diags_.error(m.range, DiagCode::E0224, "this is a component, not a value",
+                   "use one of its variables, e.g. ." + m.field + "." + firstVariableOf(s->component));
+  }
   void checkCall(const CallExpr& c) {
     std::string name = c.callee->dotted();
+    bool allowed = componentAllowed_;
+    componentAllowed_ = false;  // arguments are values
+    struct Restore {
+      bool& flag;
+      bool value;
+      ~Restore() { flag = value; }
+    } restore{componentAllowed_, allowed};
     for (const auto& na : c.namedArgs)
       diags_.error(na.nameRange, DiagCode::E0211, "named arguments are not allowed in a call to '" + name + "'",
                    "pass the arguments by position");
@@ -284,14 +597,18 @@ class Checker {
         diags_.error(e.range, DiagCode::E0213, "a string is not allowed here", "strings appear only in descriptions and unit attributes");
         return;
       case ExprKind::Name: return checkName(*cast<NameExpr>(&e));
-      case ExprKind::Member:
-        diags_.error(e.range, DiagCode::E0290, "component member access is not supported yet",
-                     "write the component's variables and equations in this model and use their plain names");
-        return;
+      case ExprKind::Member: return checkMember(*cast<MemberExpr>(&e));
       case ExprKind::Index: {
         auto* ix = cast<IndexExpr>(&e);
+        bool allowed = componentAllowed_;
+        if (referenceClass(*ix->base)) componentAllowed_ = true;  // ms[i] of an array of components
         checkExpr(*ix->base);
+        componentAllowed_ = false;  // subscripts are values
         for (const auto& s : ix->subscripts) checkExpr(*s);
+        componentAllowed_ = allowed;
+        if (referenceClass(*ix->base) && !componentAllowed_)
+          diags_.error(e.range, DiagCode::E0224, "this is a component, not a value",
+                       "use one of its variables, e.g. " + sourceText(*ix->base) + "[...]." + firstVariableOf(referenceClass(*ix->base)));
         return;
       }
       case ExprKind::Unary: return checkExpr(*cast<UnaryExpr>(&e)->operand);
@@ -329,20 +646,35 @@ class Checker {
 
 const ClassDef* findModel(const StoredDefinition& file, std::string_view name) {
   const ClassDef* last = nullptr;
+  const ClassDef* lastNested = nullptr;  // the default when the file has no top-level model
   std::function<const ClassDef*(const std::vector<std::unique_ptr<ClassDef>>&, const std::string&)> find;
   find = [&](const std::vector<std::unique_ptr<ClassDef>>& classes, const std::string& prefix) -> const ClassDef* {
     for (const auto& c : classes) {
       std::string full = prefix + c->name;
       if (c->kind == ClassKind::Model) {
         if (!name.empty() && (full == name || c->name == name)) return c.get();
-        last = c.get();
+        (prefix.empty() ? last : lastNested) = c.get();  // the default: the file's last top-level model
       }
       if (auto* r = find(c->classes, full + ".")) return r;
     }
     return nullptr;
   };
   const ClassDef* found = find(file.classes, "");
-  return name.empty() ? last : found;
+  return name.empty() ? (last ? last : lastNested) : found;
+}
+
+const CheckedClass* ModelChecker::check(const ClassDef& cls, bool root) {
+  if (auto it = done_.find(&cls); it != done_.end()) return it->second;
+  if (inProgress_.count(&cls)) return nullptr;
+  inProgress_.insert(&cls);
+  out_.classes.push_back(std::make_unique<CheckedClass>());
+  CheckedClass& c = *out_.classes.back();
+  c.cls = &cls;
+  c.fullName = lookup_.fullName(&cls);
+  ClassChecker(*this, c, root).run();
+  inProgress_.erase(&cls);
+  done_.emplace(&cls, &c);
+  return &c;
 }
 
 }  // namespace
@@ -381,12 +713,12 @@ std::string closestName(std::string_view name, const std::vector<std::string>& c
 }
 
 std::optional<CheckedModel> checkModel(const StoredDefinition& file, std::string_view modelName,
-                                       DiagnosticEngine& diags) {
+                                       DiagnosticEngine& diags, const Library& library) {
   const ClassDef* cls = findModel(file, modelName);
   if (!cls) return std::nullopt;
   CheckedModel m;
-  m.cls = cls;
-  Checker(m, diags).run();
+  ModelChecker checker(file, diags, library, m);
+  m.root = checker.check(*cls, true);
   return m;
 }
 
