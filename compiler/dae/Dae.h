@@ -65,6 +65,9 @@ struct Dae {
   std::vector<flat::Output> outputs;
   std::vector<Invariant> invariants;
   std::vector<int> coordinates;  ///< variable indices of the coordinates, in declaration order
+  /// The coordinate of each Euler–Lagrange row (the first rowCoordinates.size() equations), also
+  /// of coordinates that are not unknowns (a connector potential equal to another variable).
+  std::vector<std::string> rowCoordinates;
   flat::Experiment experiment;
   std::vector<std::string> structuralParameters;  ///< "n = 8" (flat::FlatModel::structuralParameters)
 

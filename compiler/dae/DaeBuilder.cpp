@@ -167,6 +167,7 @@ class Builder {
     for (const auto& row : eom_.rows) {
       const flat::Variable& q = m_.variables[row.coordinate];
       dae_.equations.push_back({substituted(row.residual), {flat::OriginKind::EulerLagrange, q.declRange, row.coordinate, ""}});
+      dae_.rowCoordinates.emplace_back(q.name);
     }
     for (const auto& eq : m_.equations)
       dae_.equations.push_back({substituted(eq.residual), eq.origin, substituted(eq.lhs), substituted(eq.rhs)});

@@ -51,17 +51,16 @@ void printEquations(std::ostream& os, const Dae& dae, const sym::Context& ctx, c
   os << "model " << dae.name;
   if (!dae.description.empty()) os << " \"" << dae.description << "\"";
   os << "\n\n";
-  if (!dae.coordinates.empty()) os << "Euler-Lagrange equations (d/dt dL/dder(q) - dL/dq + dD/dder(q) = Q):\n";
-  size_t row = 0;
-  for (int c : dae.coordinates) {
-    const Equation& e = dae.equations[row++];
-    os << "  " << dae.variables[c].name << ":  " << sym::toString(ctx, e.residual) << " = 0\n";
+  if (!dae.rowCoordinates.empty()) os << "Euler-Lagrange equations (d/dt dL/dder(q) - dL/dq + dD/dder(q) = Q):\n";
+  for (size_t row = 0; row < dae.rowCoordinates.size(); ++row) {
+    const Equation& e = dae.equations[row];
+    os << "  " << dae.rowCoordinates[row] << ":  " << sym::toString(ctx, e.residual) << " = 0\n";
     os << "      (" << where(sm, e.origin.range) << ")\n";
   }
   bool header = false;
   for (const auto& e : dae.equations) {
     if (e.origin.kind == flat::OriginKind::EulerLagrange || e.origin.kind == flat::OriginKind::Kinematic) continue;
-    if (!header) os << (dae.coordinates.empty() ? "" : "\n") << "equations:\n";
+    if (!header) os << (dae.rowCoordinates.empty() ? "" : "\n") << "equations:\n";
     header = true;
     os << "  " << equationText(e, ctx) << (e.origin.kind == flat::OriginKind::Constraint ? "   (constraint)" : "")
        << "\n";
@@ -93,10 +92,9 @@ void printEquationsJson(std::ostream& os, const Dae& dae, const sym::Context& ct
   auto str = [&](sym::Expr e) { return jsonString(sym::toString(ctx, e)); };
   os << "{\n  \"model\": " << jsonString(dae.name) << ",\n  \"description\": " << jsonString(dae.description)
      << ",\n  \"coordinates\": [";
-  for (size_t i = 0; i < dae.coordinates.size(); ++i) {
-    const Variable& q = dae.variables[dae.coordinates[i]];
+  for (size_t i = 0; i < dae.rowCoordinates.size(); ++i) {
     const Equation& e = dae.equations[i];
-    os << (i ? ",\n" : "\n") << "    {\"name\": " << jsonString(q.name) << ", \"equation\": " << str(e.residual)
+    os << (i ? ",\n" : "\n") << "    {\"name\": " << jsonString(dae.rowCoordinates[i]) << ", \"equation\": " << str(e.residual)
        << ", \"location\": " << jsonString(where(sm, e.origin.range)) << "}";
   }
   os << "\n  ],\n  \"equations\": [";
@@ -105,7 +103,9 @@ void printEquationsJson(std::ostream& os, const Dae& dae, const sym::Context& ct
     if (e.origin.kind == flat::OriginKind::EulerLagrange || e.origin.kind == flat::OriginKind::Kinematic) continue;
     os << (first ? "\n" : ",\n") << "    {\"residual\": " << str(e.residual) << ", \"text\": "
        << jsonString(equationText(e, ctx)) << ", \"origin\": "
-       << jsonString(e.origin.kind == flat::OriginKind::Constraint ? "constraint" : "equation")
+       << jsonString(e.origin.kind == flat::OriginKind::Constraint   ? "constraint"
+                     : e.origin.kind == flat::OriginKind::Connection ? "connection"
+                                                                     : "equation")
        << ", \"location\": " << jsonString(where(sm, e.origin.range)) << "}";
     first = false;
   }

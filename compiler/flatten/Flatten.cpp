@@ -92,8 +92,8 @@ std::optional<FlatModel> Flattener::run() {
   Instance& root = newInstance(*m_.root, nullptr, nullptr, "");
   cur_ = &root;
   guarded([&] { instantiate(root); });
-  for (size_t i = 0; i < instances_.size(); ++i)  // instantiate may not have finished: guarded
-    lowerInstance(instances_[i]);
+  for (Instance& inst : instances_) declareInstance(inst);  // variables in instance order
+  for (Instance& inst : instances_) lowerInstance(inst);
   cur_ = &root;
   if (diags_.errorCount() == errorsBefore) guarded([&] { connectAll(); });
   guarded([&] { lowerExperiment(); });
@@ -101,11 +101,15 @@ std::optional<FlatModel> Flattener::run() {
   return std::move(out_);
 }
 
-void Flattener::lowerInstance(Instance& inst) {
+void Flattener::declareInstance(Instance& inst) {
   cur_ = &inst;
   for (const auto* d : inst.cls->declarations)
     if (inst.cls->symbols.at(d->name).kind != sema::SymbolKind::Component)
       guarded([&] { valueOf(inst, *d, d->nameRange); });
+}
+
+void Flattener::lowerInstance(Instance& inst) {
+  cur_ = &inst;
   for (const auto* eq : inst.cls->equations) guarded([&] { lowerEquation(*eq, out_.equations, OriginKind::Equation); });
   for (const auto* eq : inst.cls->initialEquations)
     guarded([&] { lowerEquation(*eq, out_.initialEquations, OriginKind::InitialEquation); });

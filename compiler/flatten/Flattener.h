@@ -203,6 +203,7 @@ class Flattener {
                           const ModEntry* outer = nullptr);
   Value bindingValue(const ast::Declaration& d, const std::vector<int>& shape);
   bool hasBinding(const ast::Declaration& d);
+  void declareInstance(Instance& inst);
   void lowerInstance(Instance& inst);
 
   // Instances.cpp

@@ -88,7 +88,8 @@ class Builder {
     std::string label = "equation " + std::to_string(i + 1);
     switch (e.origin.kind) {
       case flat::OriginKind::EulerLagrange:
-        return label + " (Euler-Lagrange equation of " + variableNameOfFlat(e.origin.variable) + ")";
+        return label + " (Euler-Lagrange equation of " +
+               (i < dae_.rowCoordinates.size() ? dae_.rowCoordinates[i] : variableNameOfFlat(e.origin.variable)) + ")";
       case flat::OriginKind::Kinematic: return label + " (velocity of " + variableNameOfFlat(e.origin.variable) + ")";
       case flat::OriginKind::Constraint: return label + " (constraint" + e.origin.element + ")";
       case flat::OriginKind::Connection: return label + " (flow balance of the connection " + e.origin.element + ")";
