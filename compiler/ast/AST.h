@@ -307,10 +307,12 @@ struct ClassDef {
   std::vector<Annotation> annotations;  ///< class-level annotation(...) statements, any section
 };
 
-/// One parsed file: `within` path (optional) and its top-level classes.
+/// One parsed file: `within` path (optional), imports at its top (for all its classes) and its
+/// top-level classes.
 struct StoredDefinition {
   uint32_t file = 0;
   std::vector<std::string> within;
+  std::vector<ImportClause> imports;
   std::vector<std::unique_ptr<ClassDef>> classes;
 };
 

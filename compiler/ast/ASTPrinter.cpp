@@ -99,6 +99,7 @@ class TreePrinter {
   TreePrinter(std::ostream& os, const SourceManager& sm) : os_(os), sm_(sm) {}
 
   void file(const StoredDefinition& def);
+  void imports(const std::vector<ImportClause>& list, int indent);
   void expr(const Expr* e, int indent, const std::string& label = {});
 
  private:
@@ -130,19 +131,24 @@ void TreePrinter::file(const StoredDefinition& def) {
   os_ << "StoredDefinition";
   if (!def.within.empty()) os_ << " within " << join(def.within);
   os_ << '\n';
+  imports(def.imports, 1);
   for (const auto& c : def.classes)
     if (c) classDef(*c, 1);
+}
+
+void TreePrinter::imports(const std::vector<ImportClause>& list, int indent) {
+  for (const auto& imp : list) {
+    line(indent) << "Import " << join(imp.path) << (imp.wildcard ? ".*" : "");
+    if (!imp.alias.empty()) os_ << " as " << imp.alias;
+    os_ << at(imp.range) << '\n';
+  }
 }
 
 void TreePrinter::classDef(const ClassDef& c, int indent) {
   line(indent) << "Class " << className(c.kind) << ' ' << c.name;
   if (!c.description.empty()) os_ << ' ' << quote(c.description, true);
   os_ << at(c.range) << '\n';
-  for (const auto& imp : c.imports) {
-    line(indent + 1) << "Import " << join(imp.path) << (imp.wildcard ? ".*" : "");
-    if (!imp.alias.empty()) os_ << " as " << imp.alias;
-    os_ << at(imp.range) << '\n';
-  }
+  imports(c.imports, indent + 1);
   for (const auto& ext : c.extends) {
     line(indent + 1) << "Extends " << join(ext.baseName) << at(ext.range) << '\n';
     modifications(ext.mods, indent + 2);

@@ -374,7 +374,7 @@ void Flattener::applyAttributeList(const std::vector<ast::Modification>& mods, c
     if (mod.name != "start" && mod.name != "fixed" && mod.name != "nominal" && mod.name != "min" && mod.name != "max")
       continue;
     Value v = lower(*mod.value);
-    if (outer) v = elementOf(*outer, std::move(v));
+    if (outer) v = elementOf(*outer, v);
     if (!v.isScalar()) checkShape(v, vars.shape, mod.value->range, "the " + mod.name + " value of '" + d.name + "'");
     for (size_t i = 0; i < vars.size(); ++i) {
       Variable& var = out_.variables[out_.variableOf(vars.elems[i])];

@@ -211,7 +211,7 @@ class Flattener {
   void instantiate(Instance& inst);
   const ModEntry* modifierOf(const Instance& inst, const ast::Declaration& d);
   Value modifierValue(const ModEntry& entry, SourceRange where);
-  static Value elementOf(const ModEntry& entry, Value v);
+  static Value elementOf(const ModEntry& entry, const Value& v);
   const sema::ModelSymbol& symbolIn(const Instance& inst, const std::string& name, SourceRange where);
   Instance& instanceOf(const ast::Expr& e);
   const ComponentArray& componentArrayOf(const ast::Expr& e);

@@ -84,7 +84,7 @@ const ModEntry* Flattener::modifierOf(const Instance& inst, const Declaration& d
 
 // An array value given to an array of components gives each its element (`Mass ms[n](m = fill(1, n))`);
 // any other value applies to every element.
-Value Flattener::elementOf(const ModEntry& entry, Value v) {
+Value Flattener::elementOf(const ModEntry& entry, const Value& v) {
   if (entry.element < 0 || v.shape.size() < entry.shape.size() ||
       !std::equal(entry.shape.begin(), entry.shape.end(), v.shape.begin()))
     return v;

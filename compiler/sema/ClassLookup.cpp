@@ -5,7 +5,8 @@ namespace qdot::sema {
 
 using namespace qdot::ast;
 
-ClassLookup::ClassLookup(const StoredDefinition& file, const Library& library) : library_(library) {
+ClassLookup::ClassLookup(const StoredDefinition& file, const Library& library)
+    : fileImports_(file.imports), library_(library) {
   for (const auto& c : file.classes) {
     registerClass(*c, nullptr);
     fileClasses_.emplace(c->name, c.get());
@@ -47,11 +48,11 @@ const ClassDef* ClassLookup::resolvePath(const std::vector<std::string>& path) {
 }
 
 // `import A.B.C;` and `import C = A.B.C;` name one class; `import A.B.*;` every class of A.B.
-const ClassDef* ClassLookup::fromImports(const ClassDef& scope, const std::string& name) {
+const ClassDef* ClassLookup::fromImports(const std::vector<ImportClause>& imports, const std::string& name) {
   if (importDepth_ > 16) return nullptr;
   ++importDepth_;
   const ClassDef* found = nullptr;
-  for (const auto& imp : scope.imports) {
+  for (const auto& imp : imports) {
     if (imp.path.empty()) continue;
     if (imp.wildcard) {
       std::vector<std::string> path = imp.path;
@@ -69,11 +70,16 @@ const ClassDef* ClassLookup::fromImports(const ClassDef& scope, const std::strin
 const ClassDef* ClassLookup::resolve(const std::vector<std::string>& parts, const ClassDef* context) {
   if (parts.empty()) return nullptr;
   const ClassDef* first = nullptr;
+  const ClassDef* outermost = context;
   for (const ClassDef* s = context; s && !first; s = parent_.count(s) ? parent_.at(s) : nullptr) {
     if (s->name == parts[0] && s != context) first = s;  // an enclosing package by its own name
     if (!first) first = nested(s, parts[0]);
-    if (!first) first = fromImports(*s, parts[0]);
+    if (!first) first = fromImports(s->imports, parts[0]);
+    outermost = s;
   }
+  // The model file's own imports (at its top) serve its classes; a library file's do not.
+  bool inModelFile = outermost && fileClasses_.count(outermost->name) && fileClasses_.at(outermost->name) == outermost;
+  if (!first && inModelFile) first = fromImports(fileImports_, parts[0]);
   if (!first) first = topLevel(parts[0]);
   for (size_t i = 1; first && i < parts.size(); ++i) first = nested(first, parts[i]);
   return first;

@@ -26,11 +26,12 @@ class ClassLookup {
   void registerClass(const ast::ClassDef& c, const ast::ClassDef* parent);
   const ast::ClassDef* topLevel(const std::string& name);
   const ast::ClassDef* resolvePath(const std::vector<std::string>& path);
-  const ast::ClassDef* fromImports(const ast::ClassDef& scope, const std::string& name);
+  const ast::ClassDef* fromImports(const std::vector<ast::ImportClause>& imports, const std::string& name);
   static const ast::ClassDef* nested(const ast::ClassDef* c, const std::string& name);
 
   std::unordered_map<const ast::ClassDef*, const ast::ClassDef*> parent_;
   std::unordered_map<std::string, const ast::ClassDef*> fileClasses_;
+  const std::vector<ast::ImportClause>& fileImports_;  ///< the model file's top-level imports
   std::unordered_map<std::string, const ast::ClassDef*> libraryClasses_;  ///< by top-level name (null: not found)
   const Library& library_;
   int importDepth_ = 0;  ///< imports resolving imports: bounded, so a cycle of imports cannot loop

@@ -316,7 +316,8 @@ void Parser::tooDeep(const char* what) {
 // Files and classes
 // ---------------------------------------------------------------------------------------------
 
-/// stored_definition := ["within" [name] ";"] {class_definition}
+/// stored_definition := ["within" [name] ";"] {import_clause | class_definition}
+/// (an import at the top of a file applies to every class of the file)
 std::unique_ptr<ast::StoredDefinition> Parser::parseStoredDefinition() {
   auto def = std::make_unique<ast::StoredDefinition>();
   def->file = file_;
@@ -325,6 +326,9 @@ std::unique_ptr<ast::StoredDefinition> Parser::parseStoredDefinition() {
     uint64_t start = consumed_;
     if (at(TokenKind::kw_within)) {
       parseWithin(*def);
+    } else if (at(TokenKind::kw_import)) {
+      panic_ = false;
+      parseImport(def->imports);
     } else if (atClassKeyword()) {
       panic_ = false;
       def->classes.push_back(parseClass());
@@ -333,7 +337,7 @@ std::unique_ptr<ast::StoredDefinition> Parser::parseStoredDefinition() {
     } else {
       if (!panic_) failExpected("'model', 'connector' or 'package'", DiagCode::E0120, "a .qd file contains classes: model M ... end M;");
       reported = true;
-      while (!at(TokenKind::eof) && !atClassKeyword() && !at(TokenKind::kw_within)) take();
+      while (!at(TokenKind::eof) && !atClassKeyword() && !at(TokenKind::kw_within) && !at(TokenKind::kw_import)) take();
     }
     if (consumed_ == start) take();
   }
@@ -475,7 +479,7 @@ void Parser::parseElement(ast::ClassDef& cls) {
   } else if (at(TokenKind::kw_extends)) {
     parseExtends(cls);
   } else if (at(TokenKind::kw_import)) {
-    parseImport(cls);
+    parseImport(cls.imports);
   } else if (at(TokenKind::kw_annotation)) {
     parseAnnotationStatement();
   } else if (atElementStart()) {
@@ -507,7 +511,7 @@ void Parser::parseExtends(ast::ClassDef& cls) {
 }
 
 /// import_clause := "import" ( IDENT "=" name | name [".*"] ) [description] ";"
-void Parser::parseImport(ast::ClassDef& cls) {
+void Parser::parseImport(std::vector<ast::ImportClause>& into) {
   Token kw = take();
   ast::ImportClause imp;
   if (at(TokenKind::identifier) && peek(1).is(TokenKind::equal)) {
@@ -530,7 +534,7 @@ void Parser::parseImport(ast::ClassDef& cls) {
   }
   parseDescription();
   imp.range = rangeFrom(kw.range.begin);
-  cls.imports.push_back(std::move(imp));
+  into.push_back(std::move(imp));
   expectSemi("after the 'import' clause");
 }
 

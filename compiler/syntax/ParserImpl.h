@@ -127,7 +127,7 @@ class Parser {
   void parseClassEnd(ast::ClassDef& cls);
   void parseElement(ast::ClassDef& cls);
   void parseExtends(ast::ClassDef& cls);
-  void parseImport(ast::ClassDef& cls);
+  void parseImport(std::vector<ast::ImportClause>& into);
   void parseComponentClause(ast::ClassDef& cls);
   Prefixes parsePrefixes();
   bool parseTypeSpecifier(std::vector<std::string>& parts, SourceRange& range);
