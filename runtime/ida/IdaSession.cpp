@@ -108,6 +108,7 @@ struct IdaSession::Impl {
   void applyTolerances();
   void initialize(double tout1);
   void calculateConsistentValues(double tout1);
+  void estimateAlgebraicRates(double tout1);
   bool startIsConsistent();
   void noteChangedFixedStarts(const std::vector<double>& before);
   double advanceTo(double target);
@@ -386,6 +387,37 @@ void IdaSession::Impl::calculateConsistentValues(double tout1) {
   }
 }
 
+// IDACalcIC leaves the rates of the algebraic unknowns as they were given (0). The first step's
+// predictor then takes them as constant: the flows under a force F0 sin(wt) from rest change at
+// F0 w from the start, the predicted change is 0, and with tight tolerances the error test fails
+// at t0 however short the step. Their rates by a forward difference: the algebraic unknowns made
+// consistent again a short time later, the differential ones moved along their rates. Only the
+// predictor uses them; if that second solve fails they stay 0.
+void IdaSession::Impl::estimateAlgebraicRates(double tout1) {
+  double span = tout1 - options.t0;
+  double eps = 1e-4 * span;
+  if (!(eps > 0)) return;
+  std::vector<double> y0(data(y), data(y) + n), yp0(data(yp), data(yp) + n);
+  for (uint32_t i = 0; i < n; ++i)
+    if (model.isDifferential[i]) data(y)[i] += eps * yp0[i];
+  bool ok = true;
+  try {
+    clearFailure();
+    check(IDAReInit(ida, options.t0 + eps, y, yp), "IDAReInit");
+    check(IDACalcIC(ida, IDA_YA_YDP_INIT, options.t0 + eps + span), "IDACalcIC");
+    check(IDAGetConsistentIC(ida, y, yp), "IDAGetConsistentIC");
+  } catch (const IdaError&) {
+    ok = false;
+  }
+  std::vector<double> later(data(y), data(y) + n);
+  std::copy(y0.begin(), y0.end(), data(y));
+  std::copy(yp0.begin(), yp0.end(), data(yp));
+  if (ok)
+    for (uint32_t i = 0; i < n; ++i)
+      if (!model.isDifferential[i]) data(yp)[i] = (later[i] - y0[i]) / eps;
+  clearFailure();
+}
+
 void IdaSession::Impl::initialize(double tout1) {
   if (n == 0) return;
   bool hasAlgebraic = std::any_of(model.isDifferential, model.isDifferential + n, [](int32_t d) { return d == 0; });
@@ -395,6 +427,7 @@ void IdaSession::Impl::initialize(double tout1) {
   check(IDAGetConsistentIC(ida, y, yp), "IDAGetConsistentIC");
   calcIC = true;
   noteChangedFixedStarts(before);
+  if (hasAlgebraic) estimateAlgebraicRates(tout1);
   // Automatic scales from the consistent values. IDA binds its tolerance data during its initial
   // setup (which IDACalcIC has done), so new tolerances need a restart from the consistent point.
   check(IDAReInit(ida, options.t0, y, yp), "IDAReInit");
