@@ -85,6 +85,22 @@ structural::BipartiteGraph incidence(const Dae& dae, const sym::Context& ctx) {
                                     builder.edges());
 }
 
+
+// A connector joined to nothing has flow 0; where that leaves its potential undetermined or its
+// flow fixed twice (a Force acting on no node), the structural error is that connector's.
+void noteUnconnected(const Dae& dae, const structural::DulmageMendelsohn& dm, DiagnosticEngine& diags) {
+  std::vector<int> involved(dm.underVariables.begin(), dm.underVariables.end());
+  involved.insert(involved.end(), dm.overVariables.begin(), dm.overVariables.end());
+  for (const auto& [path, range] : dae.unconnected)
+    for (int v : involved)
+      if (dae.variables[v].name.rfind(path + ".", 0) == 0) {
+        diags.error(range, DiagCode::E0504, "connector '" + path + "' is connected to nothing",
+                    "its flow is then 0, which leaves '" + dae.variables[v].name +
+                        "' undetermined or fixed twice: connect it to the node it acts on");
+        break;
+      }
+}
+
 }  // namespace
 
 bool checkBalance(const Dae& dae, sym::Context& ctx, DiagnosticEngine& diags) {
@@ -98,6 +114,7 @@ bool checkBalance(const Dae& dae, sym::Context& ctx, DiagnosticEngine& diags) {
   std::vector<int> undetermined;
   for (int v : dm.underVariables)
     if (m.matchOfVariable[v] == structural::kUnmatched) undetermined.push_back(v);
+  noteUnconnected(dae, dm, diags);
   if (!dm.underVariables.empty()) {
     auto& d = diags.error(dae.range, neq < nvar ? DiagCode::E0501 : DiagCode::E0503,
                           (neq < nvar ? "too few equations: " : "structurally singular system: ") + counts +

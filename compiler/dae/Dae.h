@@ -70,6 +70,7 @@ struct Dae {
   std::vector<std::string> rowCoordinates;
   flat::Experiment experiment;
   std::vector<std::string> structuralParameters;  ///< "n = 8" (flat::FlatModel::structuralParameters)
+  std::vector<std::pair<std::string, SourceRange>> unconnected;  ///< flat::FlatModel::unconnected
 
   size_t stateCount() const {
     size_t n = 0;

@@ -23,6 +23,7 @@ class Builder {
     dae_.time = m_.time();
     dae_.experiment = m_.experiment;
     dae_.structuralParameters = m_.structuralParameters;
+    dae_.unconnected = m_.unconnected;
     dae_.outputs = m_.outputs;
     collectAliases();
     addParameters();

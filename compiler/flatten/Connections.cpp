@@ -127,7 +127,10 @@ void Flattener::addFlowBalances(const std::vector<std::vector<ConnectorEnd>>& se
     const sema::CheckedClass& cls = *sets[s].front().connector->cls;
     std::string names;
     for (const ConnectorEnd& e : sets[s]) names += (names.empty() ? "" : ", ") + e.connector->path;
-    if (sets[s].size() == 1) names += " (unconnected)";
+    if (sets[s].size() == 1) {
+      names += " (unconnected)";
+      out_.unconnected.push_back({sets[s].front().connector->path, ranges[s]});
+    }
     for (const Declaration* d : cls.declarations) {
       if (!d->isFlow) continue;
       std::vector<Value> flows;

@@ -104,6 +104,9 @@ struct FlatModel {
   std::vector<Output> outputs;
   /// The component instances, by path ("m1", "ms[2]", "sys.m1"); [0] is the model itself ("").
   std::vector<std::string> components;
+  /// Components' connectors joined to nothing (their flows are 0), by path, with the component's
+  /// declaration: the structural checks name them when they leave something undetermined.
+  std::vector<std::pair<std::string, SourceRange>> unconnected;
   Experiment experiment;
   /// The scalar Integer parameters the model uses, as "n = 8": structural (they size arrays), so
   /// fixed in what is compiled from this model (shown by executables' --help).
