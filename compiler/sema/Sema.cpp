@@ -213,6 +213,9 @@ class ClassChecker {
     if (d.isCoordinate || d.variability != Variability::Continuous || d.isFlow)
       diags_.error(d.range, DiagCode::E0206, "component '" + d.name + "' cannot be a coordinate, parameter, constant or flow",
                    "remove the prefix: these apply to Real variables");
+    if (c_.isConnector())
+      diags_.error(d.typeRange, DiagCode::E0290, "a connector holding a component is not supported yet",
+                   "declare the connector's variables directly: Real s; flow Real f;");
     if (!s.component) return;
     for (const auto& mod : d.mods) checkModifier(mod, *s.component);
   }
@@ -405,6 +408,11 @@ class ClassChecker {
       return;
     }
     bool potential = s->kind == SymbolKind::Unknown && !s->decl->isFlow;
+    if (auto* name = dyn_cast<NameExpr>(base); potential && name && name->parts.size() == 2) {
+      const ModelSymbol* owner = c_.find(name->parts[0]);
+      if (owner && owner->component && owner->component->isConnector() && owner->decl->dims.empty())
+        addEnergyPotential(name->dotted());  // force(a.s): a coordinate of this component
+    }
     if (s->kind != SymbolKind::Coordinate && !potential) {
       std::string name = sourceText(*base);
       diags_.error(target.range, DiagCode::E0209, "'" + name + "' is not a coordinate",
