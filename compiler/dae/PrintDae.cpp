@@ -27,19 +27,19 @@ void printVariable(std::ostream& os, size_t i, const Variable& v, const sym::Con
 }
 
 // "Euler-Lagrange row of x", "equation element [2]", "constraint".
-std::string originText(const Dae& dae, const flat::Origin& o) {
+std::string originText(const Dae& dae, size_t i, const flat::Origin& o) {
   std::string s = flat::originKindName(o.kind);
-  bool ofVariable = o.kind == flat::OriginKind::EulerLagrange || o.kind == flat::OriginKind::Kinematic;
-  if (ofVariable)
+  if (o.kind == flat::OriginKind::EulerLagrange && i < dae.rowCoordinates.size()) s += " of " + dae.rowCoordinates[i];
+  if (o.kind == flat::OriginKind::Kinematic)
     for (const Variable& v : dae.variables)
       if (v.flatVar == o.variable) s += " of " + v.name;
-  if (!o.element.empty()) s += " element " + o.element;
+  if (!o.element.empty()) s += (o.kind == flat::OriginKind::Connection ? " " : " element ") + o.element;
   return s;
 }
 
 void printEquation(std::ostream& os, size_t i, const Dae& dae, const Equation& e, const sym::Context& ctx,
                    const SourceManager& sm) {
-  os << "  " << i << " " << sym::toString(ctx, e.residual) << " = 0   [" << originText(dae, e.origin) << "]"
+  os << "  " << i << " " << sym::toString(ctx, e.residual) << " = 0   [" << originText(dae, i, e.origin) << "]"
      << at(sm, e.origin.range) << "\n";
 }
 

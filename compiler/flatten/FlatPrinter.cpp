@@ -23,6 +23,7 @@ void printVariable(std::ostream& os, const Variable& v, const sym::Context& ctx,
   if (v.min) os << ", min = " << sym::toString(ctx, v.min);
   if (v.max) os << ", max = " << sym::toString(ctx, v.max);
   if (!v.unit.empty()) os << ", unit \"" << v.unit << "\"";
+  if (v.alias) os << ", is " << sym::toString(ctx, v.alias);
   os << at(sm, v.declRange) << "\n";
 }
 
@@ -40,7 +41,8 @@ void printEquations(std::ostream& os, const char* title, const std::vector<Equat
     if (e.lhs) os << sym::toString(ctx, e.lhs) << " = " << sym::toString(ctx, e.rhs);
     else os << sym::toString(ctx, e.residual) << " = 0";
     os << at(sm, e.origin.range);
-    if (!e.origin.element.empty()) os << " element " << e.origin.element;
+    if (!e.origin.element.empty())
+      os << (e.origin.kind == OriginKind::Connection ? " connection " : " element ") << e.origin.element;
     os << "\n";
   }
 }
