@@ -177,6 +177,31 @@ TEST(ComponentModifiers, ArrayModifierOfTheWrongSizeIsOneLocatedError) {
   EXPECT_NE((d.message + d.help).find("[2]"), std::string::npos) << rendered(c);
 }
 
+TEST(ComponentModifiers, ArraysOfCompositesSplitNestedArrayModifiers) {
+  GTEST_SKIP() << "bug: Cell cs[3](k(k = {10, 20, 30})) gives E0307 'the value of 'cs[1].k.k' has shape [3], but a "
+                  "scalar is needed' (Instances.cpp passes nested modifiers on with element -1); also s(start = {...})";
+  auto r = simulate(R"(
+model Cell
+  import Vibration.*;
+  Flange a, b;
+  Spring k;
+  Mass m;
+equation
+  connect(a, k.a);
+  connect(k.b, m.a);
+  connect(m.b, b);
+end Cell;
+model Cells
+  Cell cs[3](k(k = {10, 20, 30}), m(s(start = {0.1, 0.2, 0.3})));
+end Cells;)", 0.1, 0.05);
+  ASSERT_TRUE(r->ok);
+  for (int i = 1; i <= 3; ++i) {
+    std::string c = "cs[" + std::to_string(i) + "]";
+    EXPECT_EQ(r->parameter(c + ".k.k"), 10 * i);
+    EXPECT_NEAR(r->col(c + ".m.s").front(), 0.1 * i, 1e-15);
+  }
+}
+
 TEST(ComponentModifiers, ExtendsModifierOverridesABaseParameter) {
   // x'' = −(k/m) x, x(0) = 1 with k = 4 (not the base's 100): x = cos(2t).
   auto r = simulate(R"(
