@@ -339,6 +339,20 @@ end Use;)", 2, 0.01);
   EXPECT_LT(maxError(*r, "b.s", [](double t) { return std::cos(0.5 * t); }), 1e-6);  // ω = √(1/4)
 }
 
+TEST(Packages, ImportNamingNoClassIsReported) {
+  GTEST_SKIP() << "bug: 'import Vibration.Nope;' and 'import NoPkg.*;' compile without a diagnostic (a typo in "
+                  "an import shows only where a class it should bring is used, as 'unknown class')";
+  driver::Compilation c;
+  driver::compileSource(c, "components.qd", "model Use\n  import Vibration.Nope;\n  import NoPkg.*;\n"
+                        "  Vibration.Mass m1;\nend Use;", "", driver::Stage::Check);
+  ASSERT_EQ(c.diags.diagnostics().size(), 2u) << rendered(c);
+  for (size_t i = 0; i < 2; ++i) {
+    const Diagnostic& d = c.diags.diagnostics()[i];
+    EXPECT_EQ(d.code, DiagCode::E0220);
+    EXPECT_EQ(c.sources.lineCol(d.range.file, d.range.begin).line, 2 + i);
+  }
+}
+
 // --------------------------------------------------------------------------------------- QDOT_PATH
 
 // A fresh directory, removed with everything in it; QDOT_PATH set to it while the object lives.
