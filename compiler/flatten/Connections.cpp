@@ -92,9 +92,10 @@ void Flattener::connectAll() {
     pairs.push_back({id(c.a), id(c.b)});
     pairRanges.push_back(c.range);
   }
-  // A component's connector is an inside end of its enclosing model's sets, connected or not.
+  // A component's connector is an inside end of its enclosing model's sets, connected or not; the
+  // model's own connectors are inside ends of the level above, where nothing joins them (flow 0).
   for (Instance& inst : instances_)
-    if (inst.cls->isConnector() && inst.parent && inst.parent->parent) id({&inst, false});
+    if (inst.cls->isConnector() && inst.parent) id({&inst, false});
   UnionFind sets;
   sets.grow(ends.size());
   std::vector<SourceRange> firstRange(ends.size());
@@ -233,6 +234,7 @@ void Flattener::eliminateAliases(const std::vector<std::vector<ConnectorEnd>>& s
     for (int v : list) {
       if (v == rep) continue;
       Expr value = known != bound.end() ? known->second.first : out_.variables[rep].symbol;
+      keepStart(v, rep, value);
       setAlias(v, value, where);
       // A component's own variable made equal to another stays a result column.
       if (!connectorPotential_[v]) {
@@ -246,6 +248,27 @@ void Flattener::eliminateAliases(const std::vector<std::vector<ConnectorEnd>>& s
   for (size_t i = 0; i < out_.equations.size(); ++i)
     if (i >= removed.size() || !removed[i]) out_.equations[kept++] = std::move(out_.equations[i]);
   out_.equations.resize(kept);
+}
+
+// A start value given to a variable that becomes another: moved to the representative if that has
+// none (Mass m2(s(start = 0.2)) joined rigidly to m1), else a warning when the two differ.
+void Flattener::keepStart(int var, int rep, Expr value) {
+  Variable& v = out_.variables[var];
+  if (!v.start) return;
+  Expr other = rep >= 0 ? out_.variables[rep].start : value;
+  if (rep >= 0 && !other) {
+    out_.variables[rep].start = v.start;
+    out_.variables[rep].fixed = v.fixed || out_.variables[rep].fixed;
+    return;
+  }
+  if (other == v.start) return;
+  std::string with = rep >= 0 ? "'" + std::string(out_.variables[rep].name) + "', which starts at " + sym::toString(ctx_, other)
+                              : sym::toString(ctx_, value);
+  const Instance* owner = varOwner_[var];
+  diags_.warning(owner && owner->decl ? owner->decl->nameRange : v.declRange, DiagCode::W0302,
+                 "the start value " + sym::toString(ctx_, v.start) + " of '" + std::string(v.name) +
+                     "' is not used: through connections it is " + with,
+                 "give the start value to one of the joined variables only");
 }
 
 void Flattener::setAlias(int var, Expr value, SourceRange where) {

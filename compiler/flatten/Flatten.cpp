@@ -342,11 +342,17 @@ Value Flattener::bindingValue(const Declaration& d, const std::vector<int>& shap
     checkShape(v, shape, mod->mod->value->range, "the value of '" + name + "'");
     return v;
   }
-  if (!d.binding) {
-    SourceRange where = cur_->decl ? cur_->decl->nameRange : d.nameRange;
+  if (!d.binding) {  // reported where the model compiled declares the component that holds it
+    const Instance* top = cur_;
+    std::string modifier = d.name + " = ...";
+    while (top->parent && top->parent->parent) {
+      modifier = top->decl->name + "(" + modifier + ")";
+      top = top->parent;
+    }
+    SourceRange where = top->decl ? top->decl->nameRange : d.nameRange;
     fail(where, DiagCode::E0207, "parameter '" + name + "' has no value",
-         "give it one with a modifier: " + (cur_->decl ? cur_->decl->typeName.back() : std::string("M")) + " " +
-             (cur_->decl ? cur_->decl->name : std::string("c")) + "(" + d.name + " = ...);");
+         top->decl ? "give it one with a modifier: " + top->decl->typeName.back() + " " + top->decl->name + "(" + modifier + ");"
+                   : "give it a default value, e.g. parameter Real " + d.name + " = 1;");
   }
   Value v = lower(*d.binding);
   checkShape(v, shape, d.binding->range, "the value of '" + name + "'");
@@ -374,7 +380,10 @@ void Flattener::applyAttributeList(const std::vector<ast::Modification>& mods, c
     if (mod.name != "start" && mod.name != "fixed" && mod.name != "nominal" && mod.name != "min" && mod.name != "max")
       continue;
     Value v = lower(*mod.value);
-    if (outer) v = elementOf(*outer, v);
+    if (outer) {
+      checkArrayModifier(*outer, v, mod);
+      v = elementOf(*outer, v);
+    }
     if (!v.isScalar()) checkShape(v, vars.shape, mod.value->range, "the " + mod.name + " value of '" + d.name + "'");
     for (size_t i = 0; i < vars.size(); ++i) {
       Variable& var = out_.variables[out_.variableOf(vars.elems[i])];

@@ -184,6 +184,7 @@ class Flattener {
   const sema::ModelSymbol* creating_ = nullptr;  ///< the declaration createDeclaration is making
   std::map<std::pair<const ast::Modification*, Instance*>, Value> modValues_;  ///< each modifier lowered once
   std::map<std::pair<const ast::Modification*, const Instance*>, ModEntry> extendsEntries_;
+  std::unordered_set<const ast::Modification*> badModifiers_;  ///< reported once, not per element
   std::vector<Instance*> varOwner_;       ///< by variable: the instance that declared it
   std::vector<char> connectorPotential_;  ///< by variable: a potential of a connector
   std::vector<Connection> connections_;
@@ -212,6 +213,8 @@ class Flattener {
   const ModEntry* modifierOf(const Instance& inst, const ast::Declaration& d);
   Value modifierValue(const ModEntry& entry, SourceRange where);
   static Value elementOf(const ModEntry& entry, const Value& v);
+  static ModEntry nestedEntry(const ModEntry& outer, const ast::Modification& m, const std::vector<int>& shape, size_t k);
+  void checkArrayModifier(const ModEntry& entry, const Value& v, const ast::Modification& written);
   const sema::ModelSymbol& symbolIn(const Instance& inst, const std::string& name, SourceRange where);
   Instance& instanceOf(const ast::Expr& e);
   const ComponentArray& componentArrayOf(const ast::Expr& e);
@@ -226,6 +229,7 @@ class Flattener {
   void addFlowBalances(const std::vector<std::vector<ConnectorEnd>>& sets, const std::vector<SourceRange>& ranges);
   void eliminateAliases(const std::vector<std::vector<ConnectorEnd>>& sets, const std::vector<SourceRange>& ranges);
   void setAlias(int var, sym::Expr value, SourceRange where);
+  void keepStart(int var, int rep, sym::Expr value);
   void attachFlows();
   int coordinateOfPotential(const Instance& inst, int x);
   int addVariable(Variable v);

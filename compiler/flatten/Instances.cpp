@@ -54,8 +54,8 @@ void Flattener::instantiate(Instance& inst) {
     const ModEntry* outer = modifierOf(inst, *d);
     for (size_t k = 0; k < count; ++k) {
       Instance& child = newInstance(*s.component, &inst, d, inst.prefix() + d->name + elementSuffix(shape, k));
-      if (outer)
-        for (const auto& m : outer->mod->nested) child.mods.push_back({&m, outer->scope, -1, {}});
+      if (outer)  // `cs[3](k(k = {10, 20, 30}))`: the element of cs, then of k if it is an array too
+        for (const auto& m : outer->mod->nested) child.mods.push_back(nestedEntry(*outer, m, shape, k));
       for (const auto& m : d->mods)
         child.mods.push_back({&m, &inst, shape.empty() ? -1 : static_cast<int>(k), shape});
       if (s.component->isConnector())
@@ -66,6 +66,18 @@ void Flattener::instantiate(Instance& inst) {
     }
     for (Instance* child : array.elems) instantiate(*child);
   }
+}
+
+// A modifier inside an outer one (`cs[3](k(k = {10, 20, 30}))` reaching cs[2].k): it picks the
+// outer entry's element, then this declaration's element `k` if it is an array too.
+ModEntry Flattener::nestedEntry(const ModEntry& outer, const ast::Modification& m, const std::vector<int>& shape,
+                                size_t k) {
+  if (shape.empty()) return {&m, outer.scope, outer.element, outer.shape};
+  size_t count = std::accumulate(shape.begin(), shape.end(), size_t{1}, std::multiplies<>());
+  std::vector<int> combined = outer.element >= 0 ? outer.shape : std::vector<int>{};
+  combined.insert(combined.end(), shape.begin(), shape.end());
+  int element = static_cast<int>((outer.element >= 0 ? static_cast<size_t>(outer.element) * count : 0) + k);
+  return {&m, outer.scope, element, combined};
 }
 
 // The modification of `d` in `inst`: from outside first, else its class's `extends Base(d = …)`.
@@ -103,7 +115,21 @@ Value Flattener::modifierValue(const ModEntry& entry, SourceRange) {
     Value v = lower(*entry.mod->value);
     it = modValues_.emplace(key, std::move(v)).first;
   }
+  checkArrayModifier(entry, it->second, *entry.mod);
   return elementOf(entry, it->second);
+}
+
+// An array value for an array of components must have its shape first; else one error (not one
+// per element).
+void Flattener::checkArrayModifier(const ModEntry& entry, const Value& v, const ast::Modification& written) {
+  if (entry.element < 0 || v.isScalar()) return;
+  bool fits = v.shape.size() >= entry.shape.size() && std::equal(entry.shape.begin(), entry.shape.end(), v.shape.begin());
+  if (fits) return;
+  if (!badModifiers_.insert(&written).second) throw FlattenAbort{};
+  fail(written.value->range, DiagCode::E0307,
+       "this value has shape " + shapeText(v.shape) + ", but it modifies an array of components of shape " +
+           shapeText(entry.shape),
+       "give one value per component (an array of shape " + shapeText(entry.shape) + ") or a single value for all");
 }
 
 const sema::ModelSymbol& Flattener::symbolIn(const Instance& inst, const std::string& name, SourceRange where) {

@@ -50,6 +50,7 @@ class ModelChecker {
 
   /// The checked class, or null while it is being checked (a class that contains itself).
   const CheckedClass* check(const ClassDef& cls, bool root = false);
+  void checkFileImports(const std::vector<ImportClause>& imports);
   ClassLookup& lookup() { return lookup_; }
   DiagnosticEngine& diags() { return diags_; }
   const Library& library() const { return library_; }
@@ -71,6 +72,7 @@ class ClassChecker {
       : model_(model), c_(c), diags_(model.diags()), root_(root) {}
 
   void run() {
+    checkImports(c_.cls->imports);
     for (const auto& e : c_.cls->extends) inherit(e);
     for (const auto& d : c_.cls->declarations) declare(d);
     for (const auto& d : c_.cls->declarations) checkDeclaration(d);
@@ -139,13 +141,27 @@ class ClassChecker {
     for (const auto& p : b->energyPotentials) addEnergyPotential(p);
   }
 
+  // Every import names a class or package (a typo would otherwise show only where it is used).
+  void checkImports(const std::vector<ImportClause>& imports) {
+    for (const auto& imp : imports)
+      if (!imp.path.empty() && !model_.lookup().resolve(imp.path, nullptr)) {
+        const std::string& path = model_.library().searchPath;
+        diags_.error(imp.range, DiagCode::E0220, "'" + dottedName(imp.path) + "' names no class or package",
+                     path.empty() ? "check the spelling" : "check the spelling; the library path searched: " + path);
+      }
+  }
+
+ public:
+  void checkFileImports(const std::vector<ImportClause>& imports) { checkImports(imports); }
+
+ private:
   // `extends Base(k = 1)`: each name an element of Base, values checked here.
   void checkExtendsModifiers(const ExtendsClause& e) {
     auto it = bases_.find(&e);
     if (it == bases_.end()) return;
     for (const auto& mod : e.mods) {
       const ModelSymbol* s = checkModifier(mod, *it->second);
-      if (s && s->kind != SymbolKind::Component) c_.extendsModifiers[s->decl] = &mod;
+      if (s) c_.extendsModifiers[s->decl] = &mod;
     }
   }
 
@@ -672,6 +688,11 @@ const ClassDef* findModel(const StoredDefinition& file, std::string_view name) {
   return name.empty() ? (last ? last : lastNested) : found;
 }
 
+void ModelChecker::checkFileImports(const std::vector<ImportClause>& imports) {
+  CheckedClass scratch;  // a class with no elements: only its imports are checked
+  ClassChecker(*this, scratch, false).checkFileImports(imports);
+}
+
 const CheckedClass* ModelChecker::check(const ClassDef& cls, bool root) {
   if (auto it = done_.find(&cls); it != done_.end()) return it->second;
   if (inProgress_.count(&cls)) return nullptr;
@@ -728,6 +749,7 @@ std::optional<CheckedModel> checkModel(const StoredDefinition& file, std::string
   CheckedModel m;
   ModelChecker checker(file, diags, library, m);
   m.root = checker.check(*cls, true);
+  checker.checkFileImports(file.imports);
   return m;
 }
 
