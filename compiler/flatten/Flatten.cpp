@@ -379,10 +379,15 @@ void Flattener::applyAttributeList(const std::vector<ast::Modification>& mods, c
     }
     if (mod.name != "start" && mod.name != "fixed" && mod.name != "nominal" && mod.name != "min" && mod.name != "max")
       continue;
-    Value v = lower(*mod.value);
-    if (outer) {
-      checkArrayModifier(*outer, v, mod);
-      v = elementOf(*outer, v);
+    Value v;
+    if (outer) {  // `Mass ms[n](s(start = {…}))`: lowered once for all n elements, each takes its own
+      auto key = std::make_pair(&mod, outer->scope);
+      auto it = modValues_.find(key);
+      if (it == modValues_.end()) it = modValues_.emplace(key, lower(*mod.value)).first;
+      checkArrayModifier(*outer, it->second, mod);
+      v = elementOf(*outer, it->second);
+    } else {
+      v = lower(*mod.value);
     }
     if (!v.isScalar()) checkShape(v, vars.shape, mod.value->range, "the " + mod.name + " value of '" + d.name + "'");
     for (size_t i = 0; i < vars.size(); ++i) {
