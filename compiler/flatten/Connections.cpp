@@ -140,11 +140,31 @@ void Flattener::addFlowBalances(const std::vector<std::vector<ConnectorEnd>>& se
         std::vector<Expr> terms;
         for (size_t k = 0; k < flows.size(); ++k)
           terms.push_back(sets[s][k].outside ? ctx_.neg(flows[k].elems[j]) : flows[k].elems[j]);
+        // f = 0 or f2 = -f1: an alias, not an unknown with an equation; of a flow not already one
+        // (a composite's port is in a set inside it and in one outside).
+        if (terms.size() <= 2) {
+          int pick = -1;
+          for (int k = static_cast<int>(terms.size()) - 1; k >= 0 && pick < 0; --k)
+            if (!out_.variables[out_.variableOf(flows[k].elems[j])].alias) pick = k;
+          if (pick >= 0) {
+            Expr others = terms.size() == 1 ? ctx_.zero() : terms[1 - pick];
+            eliminateFlow(out_.variableOf(flows[pick].elems[j]), sets[s][pick].outside ? others : ctx_.neg(others), ranges[s]);
+            continue;
+          }
+        }
         Expr sum = ctx_.add(terms);
         out_.equations.push_back({sum, {OriginKind::Connection, ranges[s], -1, names, 0}, sum, ctx_.zero()});
       }
     }
   }
+}
+
+// A flow fixed by its connection alone (zero when unconnected, the other's negative between two
+// connectors) is not an unknown; it stays a result column (the reaction of a wall, the force in a
+// spring).
+void Flattener::eliminateFlow(int var, Expr value, SourceRange where) {
+  setAlias(var, value, where);
+  out_.outputs.push_back({std::string(out_.variables[var].name), out_.variables[var].symbol, out_.variables[var].declRange});
 }
 
 // Potentials equal through a connection set or an alias equation are one variable: a declared

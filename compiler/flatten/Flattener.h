@@ -230,6 +230,7 @@ class Flattener {
   void eliminateAliases(const std::vector<std::vector<ConnectorEnd>>& sets, const std::vector<SourceRange>& ranges);
   void setAlias(int var, sym::Expr value, SourceRange where);
   void keepStart(int var, int rep, sym::Expr value);
+  void eliminateFlow(int var, sym::Expr value, SourceRange where);
   void attachFlows();
   int coordinateOfPotential(const Instance& inst, int x);
   int addVariable(Variable v);
