@@ -109,6 +109,7 @@ struct IdaSession::Impl {
   void initialize(double tout1);
   void calculateConsistentValues(double tout1);
   void estimateAlgebraicRates(double tout1);
+  void checkStartMatrix();
   bool startIsConsistent();
   void noteChangedFixedStarts(const std::vector<double>& before);
   double advanceTo(double target);
@@ -418,8 +419,37 @@ void IdaSession::Impl::estimateAlgebraicRates(double tout1) {
   clearFailure();
 }
 
+// Before anything is solved: the equations must contain, at the start, the derivative of every
+// differential unknown and every algebraic unknown (the columns of ∂F/∂y' and ∂F/∂y that IDA's
+// matrix needs). A column that is zero there — a mass or moment of inertia of 0 (`-p m=0`) leaves
+// its coordinate's acceleration in no equation — is named here, instead of a Newton failure later.
+void IdaSession::Impl::checkStartMatrix() {
+  uint32_t nnz = model.jacobianNonzeros;
+  std::vector<double> at0(nnz), at1(nnz);
+  if (model.jacobian(&model, options.t0, data(y), data(yp), p.data(), 0.0, at0.data()) != 0 ||
+      model.jacobian(&model, options.t0, data(y), data(yp), p.data(), 1.0, at1.data()) != 0)
+    return;  // a failing Jacobian is reported where IDA meets it, with its message
+  auto names = nameList(model.variableNames, n);
+  std::vector<std::string> missing;
+  for (uint32_t c = 0; c < n; ++c) {
+    bool zero = true;
+    for (int32_t k = model.jacobianColumnStarts[c]; k < model.jacobianColumnStarts[c + 1]; ++k)
+      zero &= (model.isDifferential[c] ? at1[k] - at0[k] : at0[k]) == 0;
+    if (zero) missing.push_back(model.isDifferential[c] ? "der(" + std::string(names[c]) + ")" : std::string(names[c]));
+  }
+  if (missing.empty()) return;
+  std::string list;
+  for (size_t i = 0; i < missing.size() && i < 8; ++i) list += (i ? ", " : "") + missing[i];
+  if (missing.size() > 8) list += fmt::format(", … ({} more)", missing.size() - 8);
+  throw IdaError(fmt::format("the equations do not determine {} at t = {:.10g}: no equation contains {} there (a "
+                             "mass or moment of inertia of 0 makes the mass matrix singular; check the parameters)",
+                             list, options.t0, missing.size() == 1 ? "it" : "them"),
+                 options.t0);
+}
+
 void IdaSession::Impl::initialize(double tout1) {
   if (n == 0) return;
+  checkStartMatrix();
   bool hasAlgebraic = std::any_of(model.isDifferential, model.isDifferential + n, [](int32_t d) { return d == 0; });
   if (!hasAlgebraic && startIsConsistent()) return;
   std::vector<double> before(data(y), data(y) + n);

@@ -72,6 +72,12 @@ contains csv-names-identifier "time,th_1," "$qdot" run "$src/examples/pendulum/n
 check csv-names-bad 2 "$qdot" run "$src/examples/pendulum/nlink.qd" --csv-names=python
 check parameter-out-of-range 2 "$qdot" run "$src/examples/textbook/utube.qd" -p rho=1e400
 contains parameter-out-of-range-says "out of range" "$qdot" run "$src/examples/textbook/utube.qd" -p rho=1e400
+# A zero mass is named before IDA runs (exit 3: the simulation cannot start), flat or from components.
+check zero-mass 3 "$qdot" run "$src/examples/vibration/two_mass.qd" -p m=0 --stop 0.1
+contains zero-mass-says "the equations do not determine der(der(x1)), der(der(x2)) at t = 0" \
+  "$qdot" run "$src/examples/vibration/two_mass.qd" -p m=0 --stop 0.1
+contains zero-mass-component-says "the equations do not determine der(der(m1.s)) at t = 0" \
+  "$qdot" run "$src/examples/vibration/two_dof.qd" -p m1.m=0 --stop 0.1
 # qdot check: every check short of solving, then one summary line (or nothing with --quiet).
 contains check-summary "model UTube is valid: 3 equations in 3 unknowns (2 states, 1 algebraic), 5 parameters" \
   "$qdot" check "$src/examples/textbook/utube.qd"
