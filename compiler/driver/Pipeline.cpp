@@ -65,7 +65,16 @@ bool derive(Compilation& c) {
 }
 
 bool buildDae(Compilation& c) {
-  c.dae = timed(c.times.dae, [&] { return dae::buildDae(*c.flat, *c.eom, c.ctx, c.diags); });
+  c.dae = timed(c.times.dae, [&] {
+    std::optional<dae::Dae> d = dae::buildDae(*c.flat, *c.eom, c.ctx, c.diags);
+    if (d && !c.options.results.empty()) {
+      std::vector<std::string> names = c.options.results;
+      if (c.options.keepInvariants)
+        for (const auto& inv : d->invariants) names.push_back(inv.name);
+      c.pruned = dae::pruneToResults(*d, names, c.ctx);
+    }
+    return d;
+  });
   return c.dae && !c.diags.hasErrors();
 }
 

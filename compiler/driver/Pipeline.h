@@ -16,6 +16,7 @@
 
 #include "ast/AST.h"
 #include "dae/Dae.h"
+#include "dae/Prune.h"
 #include "flatten/Flatten.h"
 #include "kernel/Kernel.h"
 #include "llvm/JitModel.h"
@@ -46,6 +47,10 @@ struct CompileOptions {
   flat::FlattenLimits limits;   ///< size limits of flattening (tests and fuzzing lower them)
   flat::StructuralValues structural;  ///< values of Integer parameters (see takeStructuralParameters)
   llvmbackend::JitOptions jit;  ///< what Stage::Native compiles, and how
+  /// Results asked for (`--outputs`): the DAE stage keeps only what they need (dae/Prune.h); empty:
+  /// everything. keepInvariants keeps every invariant (and what it needs) as well (`--invariants`).
+  std::vector<std::string> results;
+  bool keepInvariants = false;
 };
 
 /// Everything one compilation creates; later stages point into earlier ones, so it is not
@@ -62,6 +67,7 @@ struct Compilation {
   std::optional<flat::FlatModel> flat;
   std::optional<mech::EquationsOfMotion> eom;
   std::optional<dae::Dae> dae;
+  dae::PruneReport pruned;  ///< what --outputs kept
   std::shared_ptr<const kernel::KernelModule> kernels;
   std::optional<bc::Module> bytecode;
   ModelPtr native;                ///< the JIT-compiled model (Stage::Native)

@@ -36,6 +36,7 @@ struct Options {
   driver::ExecutableOptions exe;
   std::string buildBackend = "llvm";
   std::string at = "equilibrium";  // modes/linearize --at
+  std::vector<std::string> results;  // equations/build --outputs: compile only what these need
 };
 
 ExitCode finish(driver::Compilation& c, bool ok) {
@@ -100,10 +101,25 @@ ExitCode check(driver::Compilation& c, const Options& o) {
   return finish(c, ok);
 }
 
+// What --outputs kept (or why nothing was pruned).
+void printPruning(const dae::PruneReport& r, std::ostream& os) {
+  if (!r.unknownNames.empty()) {
+    os << "\n--outputs: nothing pruned: no variable, output or invariant is named";
+    for (const auto& n : r.unknownNames) os << " '" << n << "'";
+    os << "\n";
+    return;
+  }
+  os << "\n--outputs: kept " << r.variablesKept << " of " << r.variablesBefore << " unknowns and " << r.equationsKept
+     << " of " << r.equationsBefore << " equations (what the requested results need; outputs and first integrals "
+     << "not requested are left out)\n";
+}
+
 ExitCode equations(driver::Compilation& c, const Options& o) {
+  c.options.results = o.results;
   bool ok = driver::compileFile(c, o.file, driver::Stage::Dae);
   if (ok && o.json) dae::printEquationsJson(std::cout, *c.dae, c.ctx, c.sources);
   else if (ok) dae::printEquations(std::cout, *c.dae, c.ctx, c.sources);
+  if (ok && !o.results.empty()) printPruning(c.pruned, o.json ? std::cerr : std::cout);
   if (o.timings) printTimings(c.times);
   return finish(c, ok);
 }
@@ -126,8 +142,10 @@ driver::Backend backendOf(const Options& o) {
   return o.jitWait ? driver::Backend::Native : driver::Backend::Tiered;
 }
 
-// qdot run: compile, simulate, write the CSV.
+// qdot run: compile (only what --outputs needs), simulate, write the CSV.
 ExitCode run(driver::Compilation& c, Options& o) {
+  c.options.results = o.run.outputs;
+  if (!o.run.outputs.empty() && o.run.invariants) c.options.keepInvariants = true;
   if (std::optional<ExitCode> failed = compileToKernels(c, o)) return *failed;
   driver::RunnableModel m = driver::makeRunnableModel(c, backendOf(o), o.run.invariants);
   if (!m.model) {
@@ -151,6 +169,7 @@ ExitCode run(driver::Compilation& c, Options& o) {
 }
 
 ExitCode build(driver::Compilation& c, Options& o) {
+  c.options.results = o.results;
   if (std::string why = driver::checkOutputPath(o.exe.outputPath); !why.empty()) {
     std::cerr << "qdot: error: cannot write the executable: " << why << "\n";
     return ExitCode::Usage;
@@ -239,6 +258,8 @@ int main(int argc, char** argv) {
 
   auto* eqs = addCommand(app, "equations", "Print the derived equations of motion and the DAE", o);
   eqs->add_flag("--json", o.json, "print JSON for tools instead of text");
+  eqs->add_option("--outputs", o.results, "only what these results need: the equations and unknowns kept")
+      ->delimiter(',');
   eqs->add_flag("--timings", o.timings, "print the time each stage took");
 
   auto* run = addCommand(app, "run", "Simulate a model with SUNDIALS IDA and write the results as CSV", o);
@@ -258,6 +279,9 @@ int main(int argc, char** argv) {
                     "NAME=VALUE for an Integer parameter (it sizes arrays, so it is fixed in the executable); "
                     "repeatable")
       ->allow_extra_args(false);
+  build->add_option("--outputs", o.results,
+                    "compile only what these results need (the executable then writes these columns)")
+      ->delimiter(',');
   build->add_option("--backend", o.buildBackend, "code generator: llvm (native code, default) or bytecode (the VM, linked in)")
       ->check(CLI::IsMember({"bytecode", "llvm"}));
 

@@ -72,6 +72,11 @@ contains csv-names-identifier "time,th_1," "$qdot" run "$src/examples/pendulum/n
 check csv-names-bad 2 "$qdot" run "$src/examples/pendulum/nlink.qd" --csv-names=python
 check parameter-out-of-range 2 "$qdot" run "$src/examples/textbook/utube.qd" -p rho=1e400
 contains parameter-out-of-range-says "out of range" "$qdot" run "$src/examples/textbook/utube.qd" -p rho=1e400
+# --outputs: only what the results need (the oscillator of two uncoupled subsystems).
+contains equations-outputs "kept 2 of 5 unknowns and 2 of 5 equations" \
+  "$qdot" equations "$src/tests/sim/models/two_subsystems.qd" --outputs x
+contains equations-outputs-unknown "nothing pruned: no variable, output or invariant is named 'nope'" \
+  "$qdot" equations "$src/tests/sim/models/two_subsystems.qd" --outputs nope
 # A zero mass is named before IDA runs (exit 3: the simulation cannot start), flat or from components.
 check zero-mass 3 "$qdot" run "$src/examples/vibration/two_mass.qd" -p m=0 --stop 0.1
 contains zero-mass-says "the equations do not determine der(der(x1)), der(der(x2)) at t = 0" \

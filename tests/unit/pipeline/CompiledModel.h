@@ -50,8 +50,8 @@ class CompiledModel {
   /// The Euler–Lagrange residual of coordinate `q` at the current values.
   double eulerLagrange(const std::string& q) const { return eval(row(q)); }
   sym::Expr row(const std::string& q) const {
-    for (size_t i = 0; i < c_.dae->coordinates.size(); ++i)
-      if (c_.dae->variables[c_.dae->coordinates[i]].name == q) return c_.dae->equations[i].residual;
+    for (size_t i = 0; i < c_.dae->rowCoordinates.size(); ++i)
+      if (c_.dae->rowCoordinates[i] == q) return c_.dae->equations[i].residual;
     ADD_FAILURE() << "no coordinate " << q;
     return c_.ctx.zero();
   }
