@@ -162,6 +162,8 @@ Value Flattener::lowerIndex(const IndexExpr& e) {
     picks.push_back(subscriptIndices(*e.subscripts[d], base.shape[d]));
     if (isRange(e.subscripts[d])) result.shape.push_back(static_cast<int>(picks.back().size()));
   }
+  // An empty range (x[3:2], x[inf:1]) selects nothing.
+  if (std::any_of(picks.begin(), picks.end(), [](const std::vector<int>& p) { return p.empty(); })) return result;
   // Enumerate the cartesian product of picks in row-major order.
   std::vector<size_t> pos(picks.size(), 0);
   while (true) {
