@@ -78,12 +78,6 @@ class IncidenceBuilder {
   std::vector<sym::Expr> stack_, visited_;
 };
 
-structural::BipartiteGraph incidence(const Dae& dae, const sym::Context& ctx) {
-  IncidenceBuilder builder(dae, ctx);
-  for (int e = 0; e < static_cast<int>(dae.equations.size()); ++e) builder.addEquation(e, dae.equations[e].residual);
-  return structural::BipartiteGraph(static_cast<int>(dae.equations.size()), static_cast<int>(dae.variables.size()),
-                                    builder.edges());
-}
 
 
 // A connector joined to nothing has flow 0; where that leaves its potential undetermined or its
@@ -102,6 +96,13 @@ void noteUnconnected(const Dae& dae, const structural::DulmageMendelsohn& dm, Di
 }
 
 }  // namespace
+
+structural::BipartiteGraph incidence(const Dae& dae, const sym::Context& ctx) {
+  IncidenceBuilder builder(dae, ctx);
+  for (int e = 0; e < static_cast<int>(dae.equations.size()); ++e) builder.addEquation(e, dae.equations[e].residual);
+  return structural::BipartiteGraph(static_cast<int>(dae.equations.size()), static_cast<int>(dae.variables.size()),
+                                    builder.edges());
+}
 
 bool checkBalance(const Dae& dae, sym::Context& ctx, DiagnosticEngine& diags) {
   structural::BipartiteGraph g = incidence(dae, ctx);

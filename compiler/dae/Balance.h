@@ -5,8 +5,13 @@
 #pragma once
 
 #include "dae/Dae.h"
+#include "structural/BipartiteGraph.h"
 
 namespace qdot::dae {
+
+/// The equation–unknown graph: equation e — unknown v where e contains v's unknown symbol (a
+/// state's y', an algebraic variable's y). What the structural passes work on.
+structural::BipartiteGraph incidence(const Dae& dae, const sym::Context& ctx);
 
 /// Reports E0501 (more unknowns than equations), E0502 (more equations than unknowns) or
 /// E0503 (as many, but structurally singular) naming the culprits. Returns true if balanced.
