@@ -45,6 +45,15 @@ std::string jsonString(std::string_view s) {
   return out + "\"";
 }
 
+// The value an explicit initial equation `v = expr` (or `expr = v`) gives v, or null.
+sym::Expr initialValueOf(const Dae& dae, const Variable& v) {
+  for (const auto& e : dae.initialEquations) {
+    if (e.lhs == v.y && e.rhs) return e.rhs;
+    if (e.rhs == v.y && e.lhs) return e.lhs;
+  }
+  return nullptr;
+}
+
 }  // namespace
 
 void printEquations(std::ostream& os, const Dae& dae, const sym::Context& ctx, const SourceManager& sm) {
@@ -112,9 +121,14 @@ void printEquationsJson(std::ostream& os, const Dae& dae, const sym::Context& ct
   os << "\n  ],\n  \"variables\": [";
   for (size_t i = 0; i < dae.variables.size(); ++i) {
     const Variable& v = dae.variables[i];
+    sym::Expr initial = initialValueOf(dae, v);
+    sym::Expr start = initial ? initial : v.declaration.start;
     os << (i ? ",\n" : "\n") << "    {\"name\": " << jsonString(v.name) << ", \"kind\": "
        << jsonString(v.kind == VarKind::State ? "state" : "algebraic") << ", \"role\": " << jsonString(roleName(v.role))
-       << (v.declaration.start ? ", \"start\": " + str(v.declaration.start) : std::string()) << "}";
+       << (start ? ", \"start\": " + str(start) : std::string())
+       << (start ? std::string(", \"startFrom\": ") + (initial ? "\"initial equation\"" : "\"start\"") : std::string())
+       << (start ? std::string(", \"fixed\": ") + (initial || v.kind == VarKind::State || v.declaration.fixed ? "true" : "false") : std::string())
+       << "}";
   }
   os << "\n  ],\n  \"parameters\": [";
   for (size_t i = 0; i < dae.parameters.size(); ++i)

@@ -199,6 +199,8 @@ class Builder {
 
   // --- start values ----------------------------------------------------------------------------
 
+  std::unordered_map<size_t, size_t> initialEquationOf_;  ///< variable → the initial equation that sets it
+
   struct Start {
     Expr y0 = nullptr, yp0 = nullptr;
     uint32_t source = UINT32_MAX, derivativeSource = UINT32_MAX;
@@ -223,6 +225,7 @@ class Builder {
       for (size_t j = 0; j < dae_.variables.size(); ++j) {
         const auto& v = dae_.variables[j];
         if (v.y != target && v.yp != target) continue;
+        if (!acceptInitialEquation(e, i, j, v.y == target)) return true;  // reported
         uint32_t src = addSource("initial equation " + std::to_string(i + 1), e.origin.range, equationText(e));
         if (v.y == target) starts[j].y0 = value, starts[j].source = src, m_.description.fixed[j] = 1;
         else starts[j].yp0 = value, starts[j].derivativeSource = src;
@@ -230,6 +233,38 @@ class Builder {
       }
     }
     return false;
+  }
+
+  // What today's start values can honour, and nothing silently dropped (until the initialization
+  // system of the structural issue solves any consistent mix): the derivative of a state follows
+  // from the equations at the start, so `der(der(x)) = 5` or `der(x) = 0` of a first-order state is
+  // refused; a value given twice, or given to a variable whose declared start is fixed, is a conflict.
+  bool acceptInitialEquation(const dae::Equation& e, size_t i, size_t j, bool value) {
+    const auto& v = dae_.variables[j];
+    SourceRange at = e.origin.range.valid() ? e.origin.range : dae_.range;
+    if (!value) {
+      diags_.error(at, DiagCode::E0603,
+                   "this initial equation sets the derivative of '" + v.name +
+                       "', which the equations of motion determine at the start",
+                   "set '" + v.name + "' itself (its start value or an initial equation for it); initial "
+                   "conditions on derivatives of states are not supported yet");
+      return false;
+    }
+    auto [it, first] = initialEquationOf_.try_emplace(j, i);
+    if (!first) {
+      auto& d = diags_.error(at, DiagCode::E0604, "the initial value of '" + v.name + "' is given twice",
+                             "keep one of the two initial equations");
+      d.notes.push_back({dae_.initialEquations[it->second].origin.range, "first given here"});
+      return false;
+    }
+    if (v.declaration.start && v.declaration.fixed && v.role != dae::UnknownRole::Velocity) {
+      auto& d = diags_.error(at, DiagCode::E0604,
+                             "'" + v.name + "' has a fixed start value and this initial equation as well",
+                             "remove one of the two, or declare the start a guess: " + v.name + "(start = ..., fixed = false)");
+      d.notes.push_back({v.declaration.declRange, "declared here"});
+      return false;
+    }
+    return true;
   }
 
   std::vector<Start> collectStarts() {

@@ -77,6 +77,9 @@ contains equations-outputs "kept 2 of 5 unknowns and 2 of 5 equations" \
   "$qdot" equations "$src/tests/sim/models/two_subsystems.qd" --outputs x
 contains equations-outputs-unknown "nothing pruned: no variable, output or invariant is named 'nope'" \
   "$qdot" equations "$src/tests/sim/models/two_subsystems.qd" --outputs nope
+# qdot equations --json: a start set by an initial equation is reported as such.
+contains equations-json-initial '"name": "der(phi)", "kind": "state", "role": "velocity", "start": "10", "startFrom": "initial equation", "fixed": true' \
+  "$qdot" equations "$src/examples/textbook/governor_free.qd" --json
 # A zero mass is named before IDA runs (exit 3: the simulation cannot start), flat or from components.
 check zero-mass 3 "$qdot" run "$src/examples/vibration/two_mass.qd" -p m=0 --stop 0.1
 contains zero-mass-says "the equations do not determine der(der(x1)), der(der(x2)) at t = 0" \
