@@ -160,8 +160,18 @@ bool compileSource(Compilation& c, std::string name, std::string text, Stage unt
 namespace {
 
 // The scalar Integer parameter `name` of the checked model, or null.
+// The scalar Integer parameter `name` of the checked model, or of one of its (scalar) components
+// by dotted path (`str.n`), or null.
 const ast::Declaration* integerParameter(const sema::CheckedModel& m, const std::string& name) {
-  const sema::ModelSymbol* s = m.root->find(name);
+  const sema::CheckedClass* cls = m.root;
+  size_t begin = 0;
+  for (size_t dot; (dot = name.find('.', begin)) != std::string::npos; begin = dot + 1) {
+    const sema::ModelSymbol* part = cls->find(name.substr(begin, dot - begin));
+    if (!part || part->kind != sema::SymbolKind::Component || !part->component || !part->decl->dims.empty())
+      return nullptr;
+    cls = part->component;
+  }
+  const sema::ModelSymbol* s = cls->find(name.substr(begin));
   return s && s->kind == sema::SymbolKind::IntegerParameter ? s->decl : nullptr;
 }
 

@@ -235,9 +235,9 @@ Value Flattener::createDeclaration(const Declaration& d, const sema::ModelSymbol
   switch (kindInInstance(s.kind, root, mod && mod->mod->value)) {
     case SymbolKind::Constant:
     case SymbolKind::IntegerParameter: {
-      if (auto given = structural_.find(d.name); root && given != structural_.end()) {
+      if (auto given = structural_.find(name); given != structural_.end()) {  // -p n=3, -p str.n=40
         QDOT_ASSERT(s.kind == SymbolKind::IntegerParameter && shape.empty(), "a structural value for a non-scalar or non-Integer");
-        out_.structuralParameters.push_back(d.name + " = " + std::to_string(given->second));
+        out_.structuralParameters.push_back(name + " = " + std::to_string(given->second));
         return Value::scalar(ctx_.constant(static_cast<double>(given->second)));
       }
       Value v = bindingValue(d, shape);
@@ -361,15 +361,16 @@ Value Flattener::bindingValue(const Declaration& d, const std::vector<int>& shap
 
 // start/fixed/nominal/min/max/unit; a scalar value applies to every element of an array.
 void Flattener::applyAttributes(const Declaration& d, const Value& vars) {
-  applyAttributeList(d.mods, d, vars);
+  std::string name = cur_->prefix() + d.name;
+  applyAttributeList(d.mods, name, vars);
   if (const ModEntry* outer = modifierOf(*cur_, d); outer && !outer->mod->nested.empty()) {
     ScopeGuard scope(*this, *outer->scope);  // `Mass m1(s(start = 0.1))`: written where m1 is declared
-    applyAttributeList(outer->mod->nested, d, vars, outer);
+    applyAttributeList(outer->mod->nested, name, vars, outer);
   }
 }
 
-void Flattener::applyAttributeList(const std::vector<ast::Modification>& mods, const Declaration& d, const Value& vars,
-                                   const ModEntry* outer) {
+void Flattener::applyAttributeList(const std::vector<ast::Modification>& mods, const std::string& name,
+                                   const Value& vars, const ModEntry* outer) {
   for (const auto& mod : mods) {
     if (!mod.value) continue;
     if (mod.name == "unit") {
@@ -389,7 +390,7 @@ void Flattener::applyAttributeList(const std::vector<ast::Modification>& mods, c
     } else {
       v = lower(*mod.value);
     }
-    if (!v.isScalar()) checkShape(v, vars.shape, mod.value->range, "the " + mod.name + " value of '" + d.name + "'");
+    if (!v.isScalar()) checkShape(v, vars.shape, mod.value->range, "the " + mod.name + " value of '" + name + "'");
     for (size_t i = 0; i < vars.size(); ++i) {
       Variable& var = out_.variables[out_.variableOf(vars.elems[i])];
       Expr x = v.isScalar() ? v.elems[0] : v.elems[i];

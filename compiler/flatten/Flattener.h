@@ -199,7 +199,7 @@ class Flattener {
   std::vector<int> evaluateDims(const ast::Declaration& d);
   Value variablesFor(const ast::Declaration& d, const std::vector<int>& shape, VarRole role);
   void applyAttributes(const ast::Declaration& d, const Value& vars);
-  void applyAttributeList(const std::vector<ast::Modification>& mods, const ast::Declaration& d, const Value& vars,
+  void applyAttributeList(const std::vector<ast::Modification>& mods, const std::string& name, const Value& vars,
                           const ModEntry* outer = nullptr);
   Value bindingValue(const ast::Declaration& d, const std::vector<int>& shape);
   bool hasBinding(const ast::Declaration& d);

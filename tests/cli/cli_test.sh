@@ -80,6 +80,8 @@ contains equations-outputs-unknown "nothing pruned: no variable, output or invar
 # qdot equations --json: a start set by an initial equation is reported as such.
 contains equations-json-initial '"name": "der(phi)", "kind": "state", "role": "velocity", "start": "10", "startFrom": "initial equation", "fixed": true' \
   "$qdot" equations "$src/examples/textbook/governor_free.qd" --json
+# -p on a component's Integer parameter (structural, by its dotted path).
+contains component-integer-parameter "306.1467459" "$qdot" modes "$src/tests/sim/models/string_component.qd" -p str.n=3
 # A zero mass is named before IDA runs (exit 3: the simulation cannot start), flat or from components.
 check zero-mass 3 "$qdot" run "$src/examples/vibration/two_mass.qd" -p m=0 --stop 0.1
 contains zero-mass-says "the equations do not determine der(der(x1)), der(der(x2)) at t = 0" \
