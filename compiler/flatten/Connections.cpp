@@ -317,13 +317,25 @@ void Flattener::attachFlows() {
           const Value& p = valueOf(*c, c->cls->symbols.at(potentials[k]->name), d->nameRange);
           const Value& f = valueOf(*c, c->cls->symbols.at(flows[k]->name), d->nameRange);
           for (size_t j = 0; j < p.size() && j < f.size(); ++j) {
-            int target = coordinateOfPotential(inst, out_.variableOf(p.elems[j]));
-            if (target >= 0) out_.forces.push_back({target, {f.elems[j], d->nameRange}});
+            int potential = out_.variableOf(p.elems[j]);
+            int target = coordinateOfPotential(inst, potential);
+            if (target >= 0) out_.forces.push_back({target, {f.elems[j], d->nameRange, true}});
+            else if (!fixedPotential(potential)) out_.connectionsConserveEnergy = false;
           }
         }
       }
     }
   }
+}
+
+// A potential made one with an expression of parameters only (a Fixed flange): its flow does no work.
+bool Flattener::fixedPotential(int var) {
+  if (var < 0 || !out_.variables[var].alias) return false;
+  for (Expr s : ctx_.freeSymbols(out_.variables[var].alias)) {
+    int v = out_.variableOf(s);
+    if (v < 0 || out_.variables[v].role != VarRole::Parameter) return false;
+  }
+  return true;
 }
 
 // The coordinate of `inst` (its own, or one its energies made of a connector potential) that the

@@ -78,6 +78,7 @@ struct Equation {
 struct Term {
   sym::Expr value = nullptr;
   SourceRange range;
+  bool connectionFlow = false;  ///< a force: a connector's flow (spec §7), not a `force(q)` statement
 };
 
 struct Output {
@@ -107,6 +108,10 @@ struct FlatModel {
   /// Components' connectors joined to nothing (their flows are 0), by path, with the component's
   /// declaration: the structural checks name them when they leave something undetermined.
   std::vector<std::pair<std::string, SourceRange>> unconnected;
+  /// The connections do no work on the system: every connector's flow is a force on one of its
+  /// component's coordinates or acts where the potential is fixed, so the flows of each node cancel
+  /// in the power balance (what the Jacobi integral needs of a component model).
+  bool connectionsConserveEnergy = true;
   Experiment experiment;
   /// The scalar Integer parameters the model uses, as "n = 8": structural (they size arrays), so
   /// fixed in what is compiled from this model (shown by executables' --help).

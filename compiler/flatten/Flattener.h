@@ -233,6 +233,7 @@ class Flattener {
   void eliminateFlow(int var, sym::Expr value, SourceRange where);
   void attachFlows();
   int coordinateOfPotential(const Instance& inst, int x);
+  bool fixedPotential(int var);
   int addVariable(Variable v);
   void reserveVariables(size_t count);
   int derivativeVariable(int var, SourceRange where);

@@ -1,6 +1,7 @@
 // Euler–Lagrange rows and first integrals over an index from symbols to energy terms.
 #include "mechanics/EulerLagrange.h"
 
+#include <algorithm>
 #include <span>
 #include <utility>
 
@@ -185,14 +186,19 @@ class Deriver {
   }
 
   void findFirstIntegrals() {
-    bool conservative = m_.dissipation.empty() && m_.forces.empty() && !lagrangian_.dependsOnTime;
+    // Connector flows are forces between components: with connectionsConserveEnergy their power
+    // cancels node by node, so only `force(q)` statements make the system non-conservative.
+    bool statedForces = std::any_of(m_.forces.begin(), m_.forces.end(), [](const auto& f) { return !f.second.connectionFlow; });
+    bool conservative = m_.dissipation.empty() && !statedForces && m_.connectionsConserveEnergy &&
+                        !lagrangian_.dependsOnTime;
     for (const auto& c : m_.constraints) conservative &= !ctx_.dependsOn(c.residual, m_.time());
     std::vector<Expr> jacobi;  // Σ v ∂L/∂v, only built when the Jacobi integral exists
     for (const auto& row : out_.rows) {
       const flat::Variable& coord = m_.variables[row.coordinate];
       int v = coord.derivative;
       if (conservative) jacobi.push_back(ctx_.mul(m_.variables[v].symbol, row.momentum));
-      bool cyclic = lagrangian_.termsOf(row.coordinate).empty() && forces_[row.coordinate].empty() &&
+      bool cyclic = !m_.variables[row.coordinate].alias && lagrangian_.termsOf(row.coordinate).empty() &&
+                    forces_[row.coordinate].empty() &&
                     dissipation_.termsOf(v).empty() && !row.momentum->isZero();
       for (const auto& c : m_.constraints) cyclic &= !ctx_.dependsOn(c.residual, coord.symbol);
       if (cyclic)
