@@ -318,9 +318,14 @@ Value Flattener::variablesFor(const Declaration& d, const std::vector<int>& shap
   // a coordinate brings its velocity and acceleration
   reserveVariables(role == VarRole::Coordinate ? 3 * names.size() : names.size());
   v.elems.reserve(names.size());
+  // A component's variable is located where the model compiled declares the component (`Spring
+  // k1;`): what the user can change, rather than a line of the library.
+  const Instance* top = cur_;
+  while (top->parent && top->parent->parent) top = top->parent;
+  SourceRange where = top->decl ? top->decl->nameRange : d.nameRange;
   for (const std::string& name : names) {
     Expr symbol = ctx_.symbol(name);
-    addVariable({.role = role, .symbol = symbol, .declRange = d.nameRange, .description = d.description});
+    addVariable({.role = role, .symbol = symbol, .declRange = where, .description = d.description});
     v.elems.push_back(symbol);
   }
   slot.variables = std::move(v);
