@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <unordered_map>
 
+#include "dae/Balance.h"
 #include "structural/Matching.h"
 
 namespace qdot::dae {
@@ -19,25 +20,13 @@ std::vector<int> variableOfSymbol(const Dae& dae, const sym::Context& ctx) {
   return of;
 }
 
-// Each equation's variables (y or y'), and the graph whose edges are its unknowns (a state's y',
-// an algebraic variable's y), as the balance check builds it.
-struct Incidence {
-  std::vector<std::vector<int>> variables;  ///< per equation: every variable it contains
-  std::vector<structural::Edge> unknownEdges;
-};
-
-Incidence incidence(const Dae& dae, const sym::Context& ctx, const std::vector<int>& of) {
-  Incidence inc;
-  inc.variables.resize(dae.equations.size());
-  for (int e = 0; e < static_cast<int>(dae.equations.size()); ++e)
-    for (sym::Expr s : ctx.freeSymbols(dae.equations[e].residual)) {
-      int v = s->symbolId < of.size() ? of[s->symbolId] : -1;
-      if (v < 0) continue;
-      inc.variables[e].push_back(v);
-      const Variable& var = dae.variables[v];
-      if (s == (var.kind == VarKind::State ? var.yp : var.y)) inc.unknownEdges.push_back({e, v});
-    }
-  return inc;
+// Each equation's variables (their y or y'): what computing it needs.
+std::vector<std::vector<int>> variablesOfEquations(const Dae& dae, const sym::Context& ctx, const std::vector<int>& of) {
+  std::vector<std::vector<int>> variables(dae.equations.size());
+  for (size_t e = 0; e < dae.equations.size(); ++e)
+    for (sym::Expr s : ctx.freeSymbols(dae.equations[e].residual))
+      if (s->symbolId < of.size() && of[s->symbolId] >= 0) variables[e].push_back(of[s->symbolId]);
+  return variables;
 }
 
 }  // namespace
@@ -68,13 +57,11 @@ PruneReport pruneToResults(Dae& dae, const std::vector<std::string>& names, sym:
   }
   if (!report.unknownNames.empty() || names.empty()) return report;
 
-  Incidence inc = incidence(dae, ctx, of);
-  structural::BipartiteGraph graph(static_cast<int>(dae.equations.size()), static_cast<int>(dae.variables.size()),
-                                   inc.unknownEdges);
-  structural::Matching matching = structural::maximumMatching(graph);
+  structural::Matching matching = structural::maximumMatching(incidence(dae, ctx));
   if (!matching.isPerfect()) return report;  // not balanced: keep it whole, the checks have spoken
 
   // Closure: a needed variable needs its equation, which needs every variable it contains.
+  std::vector<std::vector<int>> variablesOf = variablesOfEquations(dae, ctx, of);
   std::vector<char> neededVar(dae.variables.size(), 0), neededEq(dae.equations.size(), 0);
   std::vector<int> work;
   auto need = [&](int v) {
@@ -96,7 +83,7 @@ PruneReport pruneToResults(Dae& dae, const std::vector<std::string>& names, sym:
       int e = matching.matchOfVariable[v];
       if (e < 0 || neededEq[e]) continue;
       neededEq[e] = 1;
-      for (int w : inc.variables[e]) need(w);
+      for (int w : variablesOf[e]) need(w);
     }
     grew = false;
     for (size_t k = 0; k < initialVariables.size(); ++k) {

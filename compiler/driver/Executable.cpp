@@ -3,6 +3,7 @@
 // file of its programs (runtime/exe/Embedded.h); the system C++ compiler links it with the static
 // runtime libraries and the shared SUNDIALS and fmt libraries of the system.
 #include "driver/Executable.h"
+#include "driver/LibraryPath.h"
 
 #include <fcntl.h>
 #include <spawn.h>
@@ -34,12 +35,6 @@ std::vector<std::string> splitPaths(std::string_view text) {
     begin = end + 1;
   }
   return out;
-}
-
-fs::path executableDirectory() {
-  std::error_code ec;
-  fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  return ec ? fs::path() : self.parent_path();
 }
 
 // The static runtime libraries: <qdot's folder>/../lib/qdot/ when installed, else the build tree.

@@ -10,13 +10,13 @@ namespace qdot::driver {
 
 namespace fs = std::filesystem;
 
-namespace {
-
 fs::path executableDirectory() {
   std::error_code ec;
   fs::path self = fs::read_symlink("/proc/self/exe", ec);
   return ec ? fs::path() : self.parent_path();
 }
+
+namespace {
 
 std::string standardLibrary() {
   std::error_code ec;

@@ -4,6 +4,7 @@
 // tree qdot was built from). A package `P` is the file `DIR/P/package.qd` or `DIR/P.qd`.
 #pragma once
 
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -13,6 +14,10 @@
 #include "support/Diagnostic.h"
 
 namespace qdot::driver {
+
+/// The folder of the running program (`<prefix>/bin` installed, the build tree otherwise): where
+/// qdot finds what it ships (the standard library; the runtime libraries of `qdot build`).
+std::filesystem::path executableDirectory();
 
 /// The directories searched, in order, for a model read from `modelFile` ("" or "-": none of its own).
 std::vector<std::string> libraryPath(const std::string& modelFile);
