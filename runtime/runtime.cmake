@@ -3,12 +3,13 @@
 # Links SUNDIALS 6.4 (Debian's shared libraries) with the dense and KLU direct linear solvers.
 find_package(SUNDIALS REQUIRED CONFIG)
 find_package(Threads REQUIRED)  # sim/TieredModel: the JIT compiles on a background thread
+find_package(Eigen3 3.4 REQUIRED NO_MODULE)  # ida/DummyDerivatives: small dense QR (header-only)
 
 add_library(qdot_runtime STATIC ${RUNTIME_SOURCES})
 target_include_directories(qdot_runtime PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include ${CMAKE_CURRENT_SOURCE_DIR})
 target_link_libraries(qdot_runtime
   PUBLIC fmt::fmt CLI11::CLI11 Threads::Threads
-  PRIVATE SUNDIALS::ida_shared SUNDIALS::nvecserial_shared SUNDIALS::sunmatrixdense_shared
+  PRIVATE Eigen3::Eigen SUNDIALS::ida_shared SUNDIALS::nvecserial_shared SUNDIALS::sunmatrixdense_shared
           SUNDIALS::sunmatrixsparse_shared SUNDIALS::sunlinsoldense_shared SUNDIALS::sunlinsolklu_shared)
 
 # qdot_exe_main: the main of standalone model executables (exe/, `qdot build`). qdot links it,

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "dae/IndexReduction.h"
 #include "structural/Matching.h"
 
 namespace qdot::dae {
@@ -108,6 +109,9 @@ bool checkBalance(const Dae& dae, sym::Context& ctx, DiagnosticEngine& diags) {
   structural::BipartiteGraph g = incidence(dae, ctx);
   structural::Matching m = structural::maximumMatching(g);
   if (m.isPerfect()) return true;
+  // Not solvable for the highest derivatives as written, but solvable once differentiated
+  // (constraints: index > 1): index reduction's case, not an error.
+  if (structural::chainsDetermined(chainStructure(dae, ctx).structure)) return true;
   structural::DulmageMendelsohn dm = structural::dulmageMendelsohn(g, m);
   size_t neq = dae.equations.size(), nvar = dae.variables.size();
   std::string counts = std::to_string(neq) + " equation" + (neq == 1 ? "" : "s") + " for " + std::to_string(nvar) +

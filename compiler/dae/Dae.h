@@ -17,7 +17,7 @@ namespace qdot::dae {
 
 enum class VarKind { State, Algebraic };
 /// What an unknown of the DAE is in the mechanics (what a declaration is: flat::VarRole).
-enum class UnknownRole { Coordinate, Velocity, State, Algebraic, Multiplier };
+enum class UnknownRole { Coordinate, Velocity, State, Algebraic, Multiplier, Derivative };
 const char* roleName(UnknownRole r);
 
 /// An unknown of the DAE: what the DAE makes of it (kind, role, symbols, result name) and its
@@ -47,6 +47,15 @@ struct Parameter {
   bool input = false;  ///< an `input` of the model (a parameter whose default is 0)
 };
 
+/// A row of F that says der(variable) = derivative: a kinematic row q' = der(q), or one added by
+/// index reduction. Together they form derivative chains (x, der(x), der(der(x))). After index
+/// reduction the run-time dummy derivative selection drops some of them (see differentiatedRows).
+struct DerivativeLink {
+  int row;
+  int variable;
+  int derivative;
+};
+
 /// A quantity conserved along solutions (first integral) or otherwise worth monitoring.
 struct Invariant {
   std::string name;
@@ -71,6 +80,18 @@ struct Dae {
   flat::Experiment experiment;
   std::vector<std::string> structuralParameters;  ///< "n = 8" (flat::FlatModel::structuralParameters)
   std::vector<std::pair<std::string, SourceRange>> unconnected;  ///< flat::FlatModel::unconnected
+  std::vector<DerivativeLink> links;  ///< every row of the form der(variable) = derivative
+  /// Index reduction (reduceIndex): per differentiated equation its rows e, e', e'', … The system then
+  /// has more rows than unknowns, by dummyDerivativeCount(): the dummy derivative method keeps
+  /// every row except as many links as there are derivatives of equations, chosen at run time where
+  /// the differentiated equations can be solved for them (Mattsson–Söderlind).
+  std::vector<std::vector<int>> differentiatedRows;
+
+  size_t dummyDerivativeCount() const {
+    size_t n = 0;
+    for (const auto& rows : differentiatedRows) n += rows.size() - 1;
+    return n;
+  }
 
   size_t stateCount() const {
     size_t n = 0;

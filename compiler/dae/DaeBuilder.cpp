@@ -36,13 +36,7 @@ class Builder {
       dae_.invariants.push_back({fi.name, fi.kind == mech::FirstIntegral::Kind::Jacobi ? "Jacobi integral" : "cyclic momentum",
                                  substituted(fi.value)});
     if (!aliases_.empty()) substituteRest();
-    // With constraints the system has index 3 and its structure is only checked once index
-    // reduction exists (structural issue); until then the counts must agree.
-    if (diags_.errorCount() == errorsBefore && eom_.multipliers.empty()) checkBalance(dae_, ctx_, diags_);
-    if (!eom_.multipliers.empty() && dae_.equations.size() != dae_.variables.size())
-      diags_.error(dae_.range, dae_.equations.size() < dae_.variables.size() ? DiagCode::E0501 : DiagCode::E0502,
-                   std::to_string(dae_.equations.size()) + " equations for " + std::to_string(dae_.variables.size()) +
-                       " unknowns");
+    if (diags_.errorCount() == errorsBefore) checkBalance(dae_, ctx_, diags_);
     if (diags_.errorCount() > errorsBefore) return std::nullopt;
     return std::move(dae_);
   }
@@ -54,6 +48,7 @@ class Builder {
   DiagnosticEngine& diags_;
   Dae dae_;
   std::vector<Equation> kinematic_;
+  std::vector<std::pair<int, int>> kinematicPairs_;  ///< per kinematic row: coordinate, velocity (index among velocities)
   std::unordered_map<Expr, Expr> aliases_;  ///< symbol of a variable that is not an unknown → its value
   uint64_t aliasMask_ = 0;
   std::vector<char> appears_;               ///< by symbol id: in some equation (after substitution)
@@ -130,14 +125,18 @@ class Builder {
       Variable qv = fromFlat(row.coordinate, VarKind::State, UnknownRole::Coordinate);
       qv.yp = ctx_.symbol("$der(" + std::string(q.name) + ")");
       kinematic_.push_back({ctx_.sub(qv.yp, v.symbol), {flat::OriginKind::Kinematic, q.declRange, row.coordinate, ""}});
+      kinematicPairs_.push_back({static_cast<int>(dae_.variables.size()), static_cast<int>(velocities.size())});
       dae_.variables.push_back(std::move(qv));
       Variable vv = fromFlat(q.derivative, inertial ? VarKind::State : VarKind::Algebraic, UnknownRole::Velocity);
       vv.declaration.start = v.start ? v.start : ctx_.zero();  // a velocity starts at 0 unless an initial equation says otherwise
       if (inertial) vv.yp = a.symbol;
       velocities.push_back(std::move(vv));
     }
+    int firstVelocity = static_cast<int>(dae_.variables.size());
     dae_.variables.insert(dae_.variables.end(), std::make_move_iterator(velocities.begin()),
                           std::make_move_iterator(velocities.end()));
+    int row = static_cast<int>(eom_.rows.size());  // the kinematic rows follow the Euler–Lagrange rows
+    for (auto [coordinate, velocity] : kinematicPairs_) dae_.links.push_back({row++, coordinate, firstVelocity + velocity});
   }
 
   void addUnknowns() {
@@ -201,6 +200,7 @@ const char* roleName(UnknownRole r) {
     case UnknownRole::State: return "state";
     case UnknownRole::Algebraic: return "algebraic";
     case UnknownRole::Multiplier: return "multiplier";
+    case UnknownRole::Derivative: return "derivative";
   }
   return "?";
 }

@@ -103,14 +103,21 @@ PruneReport pruneToResults(Dae& dae, const std::vector<std::string>& names, sym:
     if (neededVar[i]) newIndex[i] = static_cast<int>(variables.size()), variables.push_back(std::move(dae.variables[i]));
   std::vector<Equation> equations;
   std::vector<std::string> rows;
+  std::vector<int> newRow(dae.equations.size(), -1);
   for (size_t e = 0; e < dae.equations.size(); ++e) {
     if (!neededEq[e]) continue;
+    newRow[e] = static_cast<int>(equations.size());
     if (e < dae.rowCoordinates.size()) rows.push_back(dae.rowCoordinates[e]);
     equations.push_back(std::move(dae.equations[e]));
   }
   std::vector<int> coordinates;
   for (int c : dae.coordinates)
     if (newIndex[c] >= 0) coordinates.push_back(newIndex[c]);
+  std::vector<DerivativeLink> links;
+  for (const DerivativeLink& l : dae.links)
+    if (newRow[l.row] >= 0 && newIndex[l.variable] >= 0 && newIndex[l.derivative] >= 0)
+      links.push_back({newRow[l.row], newIndex[l.variable], newIndex[l.derivative]});
+  dae.links = std::move(links);
   dae.variables = std::move(variables);
   dae.equations = std::move(equations);
   dae.rowCoordinates = std::move(rows);

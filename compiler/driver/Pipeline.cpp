@@ -10,6 +10,7 @@
 #include <iterator>
 
 #include "bytecode/Emitter.h"
+#include "dae/IndexReduction.h"
 #include "syntax/Parser.h"
 
 namespace qdot::driver {
@@ -73,6 +74,7 @@ bool buildDae(Compilation& c) {
         for (const auto& inv : d->invariants) names.push_back(inv.name);
       c.pruned = dae::pruneToResults(*d, names, c.ctx);
     }
+    if (d && !dae::reduceIndex(*d, c.ctx, c.diags)) d.reset();
     return d;
   });
   return c.dae && !c.diags.hasErrors();

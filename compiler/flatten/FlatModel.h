@@ -65,6 +65,7 @@ struct Origin {
   int variable = -1;  ///< EulerLagrange/Kinematic: the coordinate; Constraint: its multiplier
   std::string element;  ///< for array equations: which element, e.g. "[2]"
   int component = 0;    ///< which component instance wrote it (FlatModel::components; 0 = the model)
+  int differentiated = 0;  ///< how many times index reduction differentiated it (0: as written)
 };
 
 /// `residual = 0` (user equations are stored as lhs - rhs).

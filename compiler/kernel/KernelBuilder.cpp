@@ -64,6 +64,13 @@ class Builder {
     for (const auto& o : dae_.outputs) d.outputNames.push_back(o.name);
     for (const auto& inv : dae_.invariants) d.invariantNames.push_back(inv.name);
     d.structuralParameters = dae_.structuralParameters;
+    if (dae_.differentiatedRows.empty()) return;  // index ≤ 1: no dummy derivatives to choose
+    for (const auto& l : dae_.links) d.derivativeLinks.insert(d.derivativeLinks.end(), {l.row, l.variable, l.derivative});
+    d.differentiatedRowStarts.push_back(0);
+    for (const auto& rows : dae_.differentiatedRows) {
+      d.differentiatedRows.insert(d.differentiatedRows.end(), rows.begin(), rows.end());
+      d.differentiatedRowStarts.push_back(static_cast<int32_t>(d.differentiatedRows.size()));
+    }
   }
 
   // Coordinates and velocities that are states start fixed; another state is fixed if it has a

@@ -130,6 +130,7 @@ int DifferentiationPlan::maxDifferentiations() const {
 }
 
 bool chainsDetermined(const DerivativeStructure& s) {
+  if (s.occurrences.size() != s.highestOrder.size()) return false;
   std::vector<Edge> edges;
   for (int e = 0; e < static_cast<int>(s.occurrences.size()); ++e)
     for (Occurrence o : s.occurrences[e]) edges.push_back({e, o.chain});
@@ -138,7 +139,7 @@ bool chainsDetermined(const DerivativeStructure& s) {
 }
 
 DifferentiationPlan pantelides(const DerivativeStructure& s) {
-  if (s.occurrences.size() != s.highestOrder.size() || !chainsDetermined(s))
+  if (!chainsDetermined(s))
     throw std::invalid_argument("pantelides: the system is not square and structurally nonsingular");
   for (const auto& list : s.occurrences)
     for (Occurrence o : list)

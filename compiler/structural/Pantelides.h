@@ -35,16 +35,15 @@ struct DifferentiationPlan {
   int maxDifferentiations() const;
 };
 
-/// True iff every equation can be matched to a distinct chain it contains (at any order): the
-/// condition under which Pantelides' algorithm terminates. Square and structurally nonsingular
-/// in this sense is what `pantelides` requires.
+/// True iff there are as many equations as chains and each equation can be matched to a distinct
+/// chain it contains (at any order): the condition under which Pantelides' algorithm terminates.
 bool chainsDetermined(const DerivativeStructure& s);
 
 /// Pantelides (1988): for each equation in turn, search an augmenting path over the highest
 /// derivatives; if there is none, differentiate every equation visited and raise the order of
 /// every chain visited, and search again from the differentiated equation. Augmenting-path search
 /// is iterative; visit marks are generation counters, so a search costs only what it visits.
-/// Precondition: equations and chains are as many and chainsDetermined(s); throws
+/// Precondition: chainsDetermined(s); throws
 /// std::invalid_argument otherwise (a compiler bug: the caller reports the user error first).
 DifferentiationPlan pantelides(const DerivativeStructure& s);
 

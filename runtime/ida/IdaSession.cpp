@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "ida/DummyDerivatives.h"
 #include "ida/IdaFlags.h"
 #include "ida/ModelCheck.h"
 
@@ -70,7 +71,8 @@ constexpr double kConsistentResidual = 1e-14;
 }  // namespace
 
 struct IdaSession::Impl {
-  const QdotModel& model;
+  std::unique_ptr<DummyDerivativeModel> dummies;  ///< after index reduction: the square system's choice
+  const QdotModel& model;                         ///< what IDA integrates (dummies->square() after index reduction)
   std::vector<double> p;
   SessionOptions options;
   uint32_t n;
@@ -79,6 +81,8 @@ struct IdaSession::Impl {
   SUNContext context = nullptr;
   void* ida = nullptr;
   N_Vector y = nullptr, yp = nullptr, id = nullptr, atol = nullptr;
+  N_Vector yStep = nullptr, ypStep = nullptr;  ///< after index reduction: the solution at IDA's last step
+  double tStep = 0;
   SUNMatrix matrix = nullptr;
   SUNLinearSolver solver = nullptr;
 
@@ -97,7 +101,12 @@ struct IdaSession::Impl {
   std::vector<std::string> warnings;
 
   Impl(const QdotModel& m, std::vector<double> values, const SessionOptions& o)
-      : model(m), p(std::move(values)), options(o), n(m.nVariables), t(o.t0) {}
+      : dummies(m.nResiduals > m.nVariables ? std::make_unique<DummyDerivativeModel>(m) : nullptr),
+        model(dummies ? dummies->square() : m),
+        p(std::move(values)),
+        options(o),
+        n(m.nVariables),
+        t(o.t0) {}
   ~Impl();
 
   void setup();
@@ -110,6 +119,11 @@ struct IdaSession::Impl {
   void calculateConsistentValues(double tout1);
   void estimateAlgebraicRates(double tout1);
   void checkStartMatrix();
+  bool chooseDummyDerivatives(double time, N_Vector yv, N_Vector ypv, bool best);
+  /// The compiled model (with all rows, before the dummy derivative choice).
+  const QdotModel& fullModel() const { return dummies ? *reinterpret_cast<const SquareTable*>(&model)->full : model; }
+  void useChoice(double time, N_Vector yv, N_Vector ypv);
+  double stepTo(double target);
   bool startIsConsistent();
   void noteChangedFixedStarts(const std::vector<double>& before);
   double advanceTo(double target);
@@ -139,7 +153,7 @@ IdaSession::Impl::~Impl() {
   if (ida) IDAFree(&ida);
   if (solver) SUNLinSolFree(solver);
   if (matrix) SUNMatDestroy(matrix);
-  for (N_Vector v : {y, yp, id, atol})
+  for (N_Vector v : {y, yp, id, atol, yStep, ypStep})
     if (v) N_VDestroy(v);
   if (context) SUNContext_Free(&context);
 }
@@ -270,18 +284,23 @@ void IdaSession::Impl::errorCallback(int code, const char*, const char*, char* m
 // --- setup ----------------------------------------------------------------------------------
 
 void IdaSession::Impl::setup() {
-  if (auto problem = checkModel(model)) throw IdaError(*problem, options.t0);
+  if (auto problem = checkModel(fullModel())) throw IdaError(*problem, options.t0);
   if (p.size() != model.nParameters)
     throw IdaError(fmt::format("{} parameter values given, the model has {}", p.size(), model.nParameters), options.t0);
   check(SUNContext_Create(nullptr, &context), "SUNContext_Create", FlagFamily::Allocation);
   if (n == 0) return;  // nothing to integrate: the session only carries time
   createVectors();
   loadInitialValues();
+  if (dummies) chooseDummyDerivatives(options.t0, y, yp, true);
   createIntegrator();
   attachLinearSolver();
 }
 
 void IdaSession::Impl::createVectors() {
+  if (dummies) {
+    yStep = created(N_VNew_Serial(n, context), "N_VNew_Serial");
+    ypStep = created(N_VNew_Serial(n, context), "N_VNew_Serial");
+  }
   y = created(N_VNew_Serial(n, context), "N_VNew_Serial");
   yp = created(N_VNew_Serial(n, context), "N_VNew_Serial");
   id = created(N_VNew_Serial(n, context), "N_VNew_Serial");
@@ -329,6 +348,8 @@ void IdaSession::Impl::attachLinearSolver() {
                                "--linear-solver klu",
                                n, n, 8.0 * n * n / (1u << 30)),
                    options.t0);
+  if (solver) SUNLinSolFree(solver), solver = nullptr;  // a new dummy derivative choice: a new pattern
+  if (matrix) SUNMatDestroy(matrix), matrix = nullptr;
   columnStarts.assign(model.jacobianColumnStarts, model.jacobianColumnStarts + n + 1);
   rowIndices.assign(model.jacobianRowIndices, model.jacobianRowIndices + nnz);
   if (kind == LinearSolverKind::Klu) {
@@ -455,6 +476,11 @@ void IdaSession::Impl::initialize(double tout1) {
   std::vector<double> before(data(y), data(y) + n);
   calculateConsistentValues(tout1);
   check(IDAGetConsistentIC(ida, y, yp), "IDAGetConsistentIC");
+  if (dummies && chooseDummyDerivatives(options.t0, y, yp, true)) {  // the start values were only a guess
+    useChoice(options.t0, y, yp);
+    calculateConsistentValues(tout1);
+    check(IDAGetConsistentIC(ida, y, yp), "IDAGetConsistentIC");
+  }
   calcIC = true;
   noteChangedFixedStarts(before);
   if (hasAlgebraic) estimateAlgebraicRates(tout1);
@@ -462,6 +488,51 @@ void IdaSession::Impl::initialize(double tout1) {
   // setup (which IDACalcIC has done), so new tolerances need a restart from the consistent point.
   check(IDAReInit(ida, options.t0, y, yp), "IDAReInit");
   applyTolerances();
+  if (dummies) {
+    N_VScale(1.0, y, yStep);
+    N_VScale(1.0, yp, ypStep);
+    tStep = options.t0;
+  }
+}
+
+// --- dummy derivatives (index reduction) ------------------------------------------------------
+
+bool IdaSession::Impl::chooseDummyDerivatives(double time, N_Vector yv, N_Vector ypv, bool best) {
+  try {
+    bool changed = dummies->choose(time, data(yv), data(ypv), p.data(), best);
+    if (changed && id)
+      for (uint32_t i = 0; i < n; ++i) data(id)[i] = model.isDifferential[i] ? 1.0 : 0.0;
+    return changed;
+  } catch (const std::runtime_error& e) {
+    throw IdaError(fmt::format("at t = {:.10g}: {}", time, e.what()), time);
+  }
+}
+
+// After a new choice at `time`: the new states' rates are the derivatives their links name (the
+// values are consistent already), and IDA restarts there with the new id vector and pattern.
+void IdaSession::Impl::useChoice(double time, N_Vector yv, N_Vector ypv) {
+  const QdotModel& full = fullModel();
+  for (uint32_t k = 0; k < full.nDerivativeLinks; ++k) {
+    const int32_t* l = full.derivativeLinks + 3 * k;
+    if (model.isDifferential[l[1]]) data(ypv)[l[1]] = data(yv)[l[2]];
+  }
+  check(IDAReInit(ida, time, yv, ypv), "IDAReInit");
+  check(IDASetId(ida, id), "IDASetId");
+  attachLinearSolver();
+}
+
+// One step at a time, so that the choice of dummy derivatives is checked after every step; the
+// output at `target` is interpolated from the last step (IDAGetDky), which is never across a restart.
+double IdaSession::Impl::stepTo(double target) {
+  while (tStep < target) {
+    if (chooseDummyDerivatives(tStep, yStep, ypStep, false)) useChoice(tStep, yStep, ypStep);
+    sunrealtype reached = tStep;
+    check(IDASolve(ida, target, &reached, yStep, ypStep, IDA_ONE_STEP), "IDASolve");
+    tStep = reached;
+  }
+  check(IDAGetDky(ida, target, 0, y), "IDAGetDky");
+  check(IDAGetDky(ida, target, 1, yp), "IDAGetDky");
+  return t = target;
 }
 
 // --- integration ----------------------------------------------------------------------------
@@ -470,6 +541,7 @@ double IdaSession::Impl::advanceTo(double target) {
   tout = target;
   if (n == 0) return t = target;
   clearFailure();
+  if (dummies) return stepTo(target);
   sunrealtype reached = t;
   check(IDASolve(ida, target, &reached, y, yp, IDA_NORMAL), "IDASolve");
   t = reached;

@@ -113,7 +113,8 @@ void writeDescription(Writer& w, const ModelDescription& d) {
   for (const auto* names : {&d.variableNames, &d.parameterNames, &d.parameterDescriptions, &d.outputNames,
                             &d.invariantNames, &d.structuralParameters})
     w.strings(*names);
-  for (const auto* ints : {&d.isDifferential, &d.fixed, &d.jacobianColumnStarts, &d.jacobianRowIndices})
+  for (const auto* ints : {&d.isDifferential, &d.fixed, &d.jacobianColumnStarts, &d.jacobianRowIndices,
+                           &d.derivativeLinks, &d.differentiatedRowStarts, &d.differentiatedRows})
     w.words(*ints);
 }
 
@@ -123,7 +124,8 @@ ModelDescription readDescription(Reader& r) {
   for (auto* names : {&d.variableNames, &d.parameterNames, &d.parameterDescriptions, &d.outputNames,
                       &d.invariantNames, &d.structuralParameters})
     *names = r.strings();
-  for (auto* ints : {&d.isDifferential, &d.fixed, &d.jacobianColumnStarts, &d.jacobianRowIndices})
+  for (auto* ints : {&d.isDifferential, &d.fixed, &d.jacobianColumnStarts, &d.jacobianRowIndices,
+                     &d.derivativeLinks, &d.differentiatedRowStarts, &d.differentiatedRows})
     *ints = r.words<int32_t>();
   return d;
 }

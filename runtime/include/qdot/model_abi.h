@@ -17,7 +17,7 @@
 extern "C" {
 #endif
 
-#define QDOT_MODEL_ABI_VERSION 1
+#define QDOT_MODEL_ABI_VERSION 2
 
 typedef struct QdotModel QdotModel;
 
@@ -28,7 +28,7 @@ struct QdotModel {
   const char* name;    /* model name */
 
   /* --- sizes and names ------------------------------------------------------------------- */
-  uint32_t nVariables;  /* y and y' have this size; so does F */
+  uint32_t nVariables;  /* y and y' have this size; so does F unless index reduction made it longer */
   uint32_t nParameters; /* run-time parameters p */
   uint32_t nOutputs;    /* extra result columns (output definitions) */
   uint32_t nInvariants; /* first integrals (energy/Jacobi, conserved momenta) */
@@ -42,7 +42,19 @@ struct QdotModel {
   /* --- Jacobian pattern (CSC) ----------------------------------------------------------------- */
   uint32_t jacobianNonzeros;
   const int32_t* jacobianColumnStarts; /* [nVariables + 1] */
-  const int32_t* jacobianRowIndices;   /* [jacobianNonzeros], ascending within a column */
+  const int32_t* jacobianRowIndices;   /* [jacobianNonzeros], ascending within a column, < nResiduals */
+
+  /* --- index reduction (dummy derivatives) -------------------------------------------------- */
+  /* F has nResiduals >= nVariables rows. Beyond nVariables they come from differentiated
+   * equations (constraints): the runtime keeps all rows but one link per derivative of an
+   * equation, chosen from the values (the dummy derivative method), and gives IDA that square
+   * system. Without index reduction nResiduals == nVariables and the tables are empty. */
+  uint32_t nResiduals;
+  uint32_t nDerivativeLinks;
+  const int32_t* derivativeLinks;          /* [3*nDerivativeLinks]: row, variable, derivative */
+  uint32_t nDifferentiatedEquations;
+  const int32_t* differentiatedRowStarts;  /* [nDifferentiatedEquations + 1] into differentiatedRows */
+  const int32_t* differentiatedRows;       /* rows of e, e', e'', … per differentiated equation */
 
   /* --- functions ---------------------------------------------------------------------------- */
   /* Parameter values: p[i] = overridden[i] ? given[i] : default binding of parameter i, evaluated

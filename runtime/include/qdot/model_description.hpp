@@ -24,17 +24,30 @@ struct ModelDescription {
   /// The Integer parameters, as "n = 8": they size the model, so they are fixed in what was
   /// compiled (an executable's --help shows them; qdot build -p n=3 changes them).
   std::vector<std::string> structuralParameters;
+  /// Index reduction (empty for a model of index ≤ 1). Triplets (row, variable, derivative): row
+  /// says der(variable) = derivative. Per differentiated equation (differentiatedRowStarts, size
+  /// count + 1, into differentiatedRows): its rows e, e', e'', … The residual then has
+  /// residualCount() rows; the run time keeps all but dummyDerivativeCount() links.
+  std::vector<int32_t> derivativeLinks;
+  std::vector<int32_t> differentiatedRowStarts, differentiatedRows;
 
   size_t variableCount() const { return variableNames.size(); }
   size_t parameterCount() const { return parameterNames.size(); }
   size_t jacobianNonzeros() const { return jacobianRowIndices.size(); }
+  size_t differentiatedEquationCount() const {
+    return differentiatedRowStarts.empty() ? 0 : differentiatedRowStarts.size() - 1;
+  }
+  /// Derivatives of equations in the system: as many links are dropped (dummy derivatives).
+  size_t dummyDerivativeCount() const { return differentiatedRows.size() - differentiatedEquationCount(); }
+  /// Rows of F: one per variable, plus one per dummy derivative.
+  size_t residualCount() const { return variableCount() + dummyDerivativeCount(); }
 
   /// How many values program `p` writes for this model (initialValues: y0, yp0 and nominal).
   size_t outputCount(ModelProgram p) const {
     switch (p) {
       case ModelProgram::Parameters: return parameterCount();
       case ModelProgram::InitialValues: return 3 * variableCount();
-      case ModelProgram::Residual: return variableCount();
+      case ModelProgram::Residual: return residualCount();
       case ModelProgram::Jacobian: return jacobianNonzeros();
       case ModelProgram::Outputs: return outputNames.size();
       case ModelProgram::Invariants: return invariantNames.size();
@@ -48,6 +61,7 @@ struct ModelDescription {
     size_t n = variableCount();
     if (isDifferential.size() != n || fixed.size() != n) return "per-variable tables have the wrong size";
     if (parameterDescriptions.size() != parameterCount()) return "parameter descriptions have the wrong size";
+    if (auto problem = indexReductionInconsistency(); !problem.empty()) return problem;
     const auto& starts = jacobianColumnStarts;
     const auto& rows = jacobianRowIndices;
     if (starts.size() != n + 1 || starts[0] != 0 || static_cast<size_t>(starts[n]) != rows.size())
@@ -55,9 +69,28 @@ struct ModelDescription {
     for (size_t j = 0; j < n; ++j) {
       if (starts[j] > starts[j + 1]) return "Jacobian column starts decrease";
       for (int32_t k = starts[j]; k < starts[j + 1]; ++k)
-        if (rows[k] < 0 || static_cast<size_t>(rows[k]) >= n || (k > starts[j] && rows[k] <= rows[k - 1]))
+        if (rows[k] < 0 || static_cast<size_t>(rows[k]) >= residualCount() || (k > starts[j] && rows[k] <= rows[k - 1]))
           return "Jacobian row indices out of range or not ascending in column " + std::to_string(j);
     }
+    return "";
+  }
+
+  /// What is inconsistent in the index reduction tables, "" if nothing.
+  std::string indexReductionInconsistency() const {
+    if (derivativeLinks.size() % 3 != 0) return "derivative links are not triplets";
+    const auto& starts = differentiatedRowStarts;
+    if (!starts.empty() && (starts[0] != 0 || static_cast<size_t>(starts.back()) != differentiatedRows.size()))
+      return "differentiated row starts are inconsistent";
+    for (size_t k = 0; k + 1 < starts.size(); ++k)
+      if (starts[k + 1] - starts[k] < 2) return "a differentiated equation has fewer than two rows";
+    size_t rowsEnd = residualCount();
+    for (int32_t r : differentiatedRows)
+      if (r < 0 || static_cast<size_t>(r) >= rowsEnd) return "a differentiated row is out of range";
+    for (size_t k = 0; k < derivativeLinks.size(); k += 3)
+      if (derivativeLinks[k] < 0 || static_cast<size_t>(derivativeLinks[k]) >= rowsEnd || derivativeLinks[k + 1] < 0 ||
+          static_cast<size_t>(derivativeLinks[k + 1]) >= variableCount() || derivativeLinks[k + 2] < 0 ||
+          static_cast<size_t>(derivativeLinks[k + 2]) >= variableCount())
+        return "a derivative link is out of range";
     return "";
   }
 };

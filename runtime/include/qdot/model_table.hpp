@@ -41,6 +41,12 @@ inline void fillModelTable(QdotModel& m, ModelNameTable& names, const ModelDescr
   m.jacobianNonzeros = static_cast<uint32_t>(d.jacobianRowIndices.size());
   m.jacobianColumnStarts = d.jacobianColumnStarts.data();
   m.jacobianRowIndices = d.jacobianRowIndices.data();
+  m.nResiduals = static_cast<uint32_t>(d.residualCount());
+  m.nDerivativeLinks = static_cast<uint32_t>(d.derivativeLinks.size() / 3);
+  m.derivativeLinks = d.derivativeLinks.data();
+  m.nDifferentiatedEquations = static_cast<uint32_t>(d.differentiatedEquationCount());
+  m.differentiatedRowStarts = d.differentiatedRowStarts.data();
+  m.differentiatedRows = d.differentiatedRows.data();
 }
 
 }  // namespace qdot
