@@ -336,6 +336,10 @@ TEST(SliderCrank, MatchesHandReducedRk4) {
       r, "E", [&](double) { return e0; }, [&](double t) { return 2 * oscillationBound(rtol, e0, revolution, t); });
   expectConstraintsHeld(r, 2, rtol, sc.r + sc.L, 2 * sc.r * sc.omega0);
   EXPECT_GT(r.col("phi").back(), 2 * M_PI) << "a full revolution";
+  // The dependent velocities at the start follow from the differentiated constraints (their
+  // declared start 0 is not consistent): psi' = −(r/L) omega0, xB' = 0 at phi = 0.
+  EXPECT_NEAR(r.col("der(psi)").front(), -sc.r / sc.L * sc.omega0, 100 * rtol * sc.omega0);
+  EXPECT_NEAR(r.col("der(xB)").front(), 0, 100 * rtol * sc.r * sc.omega0);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -606,6 +610,11 @@ TEST(CarAxis, PublishedReferenceAtT3) {
               << "\n";
   }
   expectConstraintsHeld(r, 2, rtol, 1, 2);
+  // The start velocities of the dependent coordinates follow from the differentiated constraints:
+  // xl' = xr' = −L0/L (their declared start 0 is not consistent).
+  const CarAxis ca;
+  EXPECT_NEAR(r.col("der(xl)").front(), -ca.L0 / ca.L, 100 * rtol);
+  EXPECT_NEAR(r.col("der(xr)").front(), -ca.L0 / ca.L, 100 * rtol);
 }
 
 }  // namespace
