@@ -7,10 +7,11 @@
 // g_k = lhs − rhs and dg_k/dt are the invariant columns constraint[k] and der(constraint[k]) (with
 // --invariants), which must stay near 0.
 // The ConstrainedReference tests check the references themselves (they need no qdot run).
+#include <sys/wait.h>
+
 #include <array>
 #include <cmath>
 #include <cstdlib>
-#include <sys/wait.h>
 
 #include "QdotRun.h"
 
@@ -139,7 +140,8 @@ TEST(ConstrainedModels, DeriveAndBalance) {
     std::size_t listed = 0;
     for (std::size_t at = text.find("(constraint)"); at != std::string::npos; at = text.find("(constraint)", at + 1))
       ++listed;
-    EXPECT_GE(listed, static_cast<std::size_t>(constraints)) << model << ": the constraints listed (index reduction may list their derivatives too)";
+    EXPECT_GE(listed, static_cast<std::size_t>(constraints))
+        << model << ": the constraints listed (index reduction may list their derivatives too)";
   }
 }
 
@@ -189,9 +191,7 @@ TEST(ConstrainedReference, PendulumPeriodFormulaAgreesWithRk4) {
 // cartesian_pendulum.qd: m = 1, l = 1, g = 9.81, released from rest at θ0 = 1 rad.
 constexpr double kPendulumG = 9.81, kPendulumL = 1, kPendulumM = 1, kPendulumTheta0 = 1;
 
-double pendulumPeriod() {
-  return 4 * std::sqrt(kPendulumL / kPendulumG) * ellipticK(std::sin(kPendulumTheta0 / 2));
-}
+double pendulumPeriod() { return 4 * std::sqrt(kPendulumL / kPendulumG) * ellipticK(std::sin(kPendulumTheta0 / 2)); }
 
 // At rtol 1e-8 over the annotation's 30 s (about 14 periods, output every 0.01 s): the mean period
 // between the first and last upward zero crossings of x equals P within 1e-6 relative (a crossing
@@ -289,7 +289,8 @@ struct SliderCrank {
 // crank completes at least 5 revolutions in 2 s.
 TEST(ConstrainedReference, SliderCrankReducedModel) {
   const SliderCrank sc;
-  const double j0 = sc.mc * sc.r * sc.r / 3 + sc.mr * sc.r * sc.r / 4 + sc.mr * sc.L * sc.L / 12 * std::pow(sc.r / sc.L, 2);
+  const double j0 =
+      sc.mc * sc.r * sc.r / 3 + sc.mr * sc.r * sc.r / 4 + sc.mr * sc.L * sc.L / 12 * std::pow(sc.r / sc.L, 2);
   EXPECT_NEAR(sc.inertia(0.0), j0, 1e-16);
   for (double phi : {0.3, 1.2, 2.5, 4.0}) {
     const double step = 1e-5, difference = (sc.inertia(phi + step) - sc.inertia(phi - step)) / (2 * step);
@@ -325,12 +326,15 @@ TEST(SliderCrank, MatchesHandReducedRk4) {
   for (const auto& y : path) slope = std::max(slope, std::fabs(sc.rhs(0, y)[1] / y[1]));
   auto at = [&](double t) { return path[static_cast<std::size_t>(std::lround(t / interval))]; };
   auto phiBound = [&](double t) { return 100 * rtol * 2 * M_PI * std::pow(1 + t / revolution, 2); };
-  compareColumn(r, "phi", [&](double t) { return at(t)[0]; }, phiBound);
+  compareColumn(
+      r, "phi", [&](double t) { return at(t)[0]; }, phiBound);
   compareColumn(
       r, "der(phi)", [&](double t) { return at(t)[1]; },
       [&](double t) { return slope * phiBound(t) + oscillationBound(rtol, sc.omega0, revolution, t); });
-  compareColumn(r, "psi", [&](double t) { return sc.psi(at(t)[0]); }, phiBound);
-  compareColumn(r, "xB", [&](double t) { return sc.xB(at(t)[0]); }, [&](double t) { return 2 * sc.r * phiBound(t); });
+  compareColumn(
+      r, "psi", [&](double t) { return sc.psi(at(t)[0]); }, phiBound);
+  compareColumn(
+      r, "xB", [&](double t) { return sc.xB(at(t)[0]); }, [&](double t) { return 2 * sc.r * phiBound(t); });
   const double e0 = sc.energy(path.front());
   compareColumn(
       r, "E", [&](double) { return e0; }, [&](double t) { return 2 * oscillationBound(rtol, e0, revolution, t); });
@@ -361,7 +365,8 @@ TEST(ConstrainedReference, EllipsographSliderKineticEnergy) {
   const Ellipsograph e;
   for (double theta : {0.0, 0.3, 1.0, 2.5}) {
     const double thetaDot = 1.7;
-    const double t = e.kineticInSliders(thetaDot, -2 * e.l * std::sin(theta) * thetaDot, 2 * e.l * std::cos(theta) * thetaDot);
+    const double t =
+        e.kineticInSliders(thetaDot, -2 * e.l * std::sin(theta) * thetaDot, 2 * e.l * std::cos(theta) * thetaDot);
     EXPECT_NEAR(t, 0.5 * (3 * e.m + 4 * e.m1) * e.l * e.l * thetaDot * thetaDot, 1e-14);
   }
 }
@@ -377,10 +382,14 @@ TEST(EllipsographSliders, ClosedForm) {
   ASSERT_EQ(r.exitCode, 0) << r.log;
   expectGrid(r, 0, 2, 0.01);
   auto bound = [&](double t) { return 100 * rtol * (e.theta(t) + e.theta0); };
-  compareColumn(r, "theta", [&](double t) { return e.theta(t); }, bound);
-  compareColumn(r, "der(theta)", [&](double t) { return a * t; }, [&](double t) { return 100 * rtol * (a * t + e.theta0); });
-  compareColumn(r, "xA", [&](double t) { return 2 * e.l * std::cos(e.theta(t)); }, [&](double t) { return 2 * e.l * bound(t); });
-  compareColumn(r, "yB", [&](double t) { return 2 * e.l * std::sin(e.theta(t)); }, [&](double t) { return 2 * e.l * bound(t); });
+  compareColumn(
+      r, "theta", [&](double t) { return e.theta(t); }, bound);
+  compareColumn(
+      r, "der(theta)", [&](double t) { return a * t; }, [&](double t) { return 100 * rtol * (a * t + e.theta0); });
+  compareColumn(
+      r, "xA", [&](double t) { return 2 * e.l * std::cos(e.theta(t)); }, [&](double t) { return 2 * e.l * bound(t); });
+  compareColumn(
+      r, "yB", [&](double t) { return 2 * e.l * std::sin(e.theta(t)); }, [&](double t) { return 2 * e.l * bound(t); });
   expectConstraintsHeld(r, 2, rtol, 2 * e.l, 2 * e.l * a * 2);
 }
 
@@ -424,12 +433,15 @@ TEST(RollingCylinder, ClosedFormAndFriction) {
   auto r = runConstrained("examples/constrained/rolling_cylinder.qd", {"--rtol", num(rtol)});
   ASSERT_EQ(r.exitCode, 0) << r.log;
   expectGrid(r, 0, 2, 0.01);
-  compareColumn(r, "x", [&](double t) { return a * t * t / 2; }, [&](double t) { return 100 * rtol * (a * t * t / 2 + xEnd); });
-  compareColumn(r, "der(x)", [&](double t) { return a * t; }, [&](double t) { return 100 * rtol * (a * t + a); });
+  compareColumn(
+      r, "x", [&](double t) { return a * t * t / 2; }, [&](double t) { return 100 * rtol * (a * t * t / 2 + xEnd); });
+  compareColumn(
+      r, "der(x)", [&](double t) { return a * t; }, [&](double t) { return 100 * rtol * (a * t + a); });
   compareColumn(
       r, "phi", [&](double t) { return a * t * t / 2 / c.R; },
       [&](double t) { return 100 * rtol * (a * t * t / 2 + xEnd) / c.R; });
-  compareColumn(r, "lambda[1]", [&](double) { return c.friction(); }, [&](double) { return 1e-6 * std::fabs(c.friction()); });
+  compareColumn(
+      r, "lambda[1]", [&](double) { return c.friction(); }, [&](double) { return 1e-6 * std::fabs(c.friction()); });
   expectConstraintsHeld(r, 1, rtol, xEnd, 2 * a);
 }
 
@@ -442,7 +454,7 @@ struct CarAxis {
   double eps = 1e-2, M = 10, L = 1, L0 = 0.5, r = 0.1, w = 10, g = 1;
   double k() const { return M * eps * eps / 2; }
   static constexpr std::array<double, 10> kReferenceAt3{
-      0.4934557842755629e-01, 0.4969894602303324e+00, 0.1041742524885400e+01, 0.3739110272652214e+00,
+      0.4934557842755629e-01,  0.4969894602303324e+00, 0.1041742524885400e+01, 0.3739110272652214e+00,
       -0.7705836840321485e-01, 0.7446866596327776e-02, 0.1755681574942899e-01, 0.7703410437794031e+00,
       -0.4736886750784630e-02, -0.1104680411345730e-02};
 
@@ -471,7 +483,8 @@ struct CarAxis {
   // The test set's right-hand sides f(5..8) (k y'(5..8) = f(5..8)), transcribed from caraxis.f.
   std::array<double, 4> testSetForces(const std::array<double, 10>& y, double t) const {
     const double xl = y[0], yl = y[1], xr = y[2], yr = y[3], lam1 = y[8], lam2 = y[9];
-    const double ll = std::sqrt(xl * xl + yl * yl), lr = std::sqrt((xr - xb(t)) * (xr - xb(t)) + (yr - yb(t)) * (yr - yb(t)));
+    const double ll = std::sqrt(xl * xl + yl * yl),
+                 lr = std::sqrt((xr - xb(t)) * (xr - xb(t)) + (yr - yb(t)) * (yr - yb(t)));
     return {(L0 - ll) * xl / ll + lam1 * xb(t) + 2 * lam2 * (xl - xr),
             (L0 - ll) * yl / ll + lam1 * yb(t) + 2 * lam2 * (yl - yr) - M * eps * eps * g / 2,
             (L0 - lr) * (xr - xb(t)) / lr - 2 * lam2 * (xl - xr),
@@ -543,7 +556,7 @@ std::array<double, N> solveLinear(std::array<std::array<double, N>, N> A, std::a
 //   g2'' = 2 (xl' − xr')² + 2 (yl' − yr')² + 2 (xl − xr)(xl'' − xr'') + 2 (yl − yr)(yl'' − yr'').
 // ∂V/∂q and G by dual numbers of V and g as written in car_axis.qd. Returns (q', q'') and λ.
 std::pair<std::array<double, 8>, std::array<double, 2>> carAxisIndexOne(const CarAxis& ca, double t,
-                                                                         const std::array<double, 8>& y) {
+                                                                        const std::array<double, 8>& y) {
   std::array<double, 4> force{};
   std::array<std::array<double, 4>, 2> G{};
   for (int j = 0; j < 4; ++j) {
@@ -600,7 +613,7 @@ TEST(CarAxis, PublishedReferenceAtT3) {
   expectGrid(r, 0, 3, 0.01);
   const auto& y = CarAxis::kReferenceAt3;
   const std::array<const char*, 10> columns{"xl",      "yl",      "xr",      "yr",        "der(xl)",
-                                             "der(yl)", "der(xr)", "der(yr)", "lambda[1]", "lambda[2]"};
+                                            "der(yl)", "der(xr)", "der(yr)", "lambda[1]", "lambda[2]"};
   for (std::size_t i = 0; i < columns.size(); ++i) {
     const auto& c = r.col(columns[i]);
     ASSERT_FALSE(c.empty()) << columns[i];
