@@ -3,6 +3,8 @@
 
 #include "dae/Dae.h"
 
+#include <algorithm>
+
 namespace qdot::dae {
 namespace {
 
@@ -29,6 +31,24 @@ void printSystemSummary(std::ostream& os, const Dae& dae) {
   os << "system: " << dae.equations.size() << " equations, " << dae.variables.size() << " unknowns (" << states
      << " differential, " << dae.variables.size() - states << " algebraic), " << dae.parameters.size()
      << " parameters\n";
+  if (dae.differentiatedRows.empty()) return;
+  // Index reduction: which links may be dropped is decided by the run (dummy derivatives).
+  size_t dummies = dae.dummyDerivativeCount();
+  os << "index reduction: " << dae.differentiatedRows.size() << " equation"
+     << (dae.differentiatedRows.size() == 1 ? "" : "s") << " differentiated (Pantelides); the run drops " << dummies
+     << " of the links der(v) = ..., choosing " << dummies << " dummy derivative" << (dummies == 1 ? "" : "s")
+     << " where the differentiated equations are best conditioned (" << dummies << " of the states above become "
+     << "algebraic)\n";
+}
+
+// ", differentiated twice" for an equation index reduction differentiated.
+std::string differentiatedText(const flat::Origin& o) {
+  switch (o.differentiated) {
+    case 0: return "";
+    case 1: return ", differentiated once";
+    case 2: return ", differentiated twice";
+    default: return ", differentiated " + std::to_string(o.differentiated) + " times";
+  }
 }
 
 std::string jsonString(std::string_view s) {
@@ -71,8 +91,10 @@ void printEquations(std::ostream& os, const Dae& dae, const sym::Context& ctx, c
     if (e.origin.kind == flat::OriginKind::EulerLagrange || e.origin.kind == flat::OriginKind::Kinematic) continue;
     if (!header) os << (dae.rowCoordinates.empty() ? "" : "\n") << "equations:\n";
     header = true;
-    os << "  " << equationText(e, ctx) << (e.origin.kind == flat::OriginKind::Constraint ? "   (constraint)" : "")
-       << "\n";
+    std::string origin = e.origin.kind == flat::OriginKind::Constraint ? "constraint" : "";
+    origin += differentiatedText(e.origin);
+    if (!origin.empty() && origin[0] == ',') origin = "equation" + origin;
+    os << "  " << equationText(e, ctx) << (origin.empty() ? "" : "   (" + origin + ")") << "\n";
   }
   if (!dae.initialEquations.empty()) {
     os << "\ninitial equations:\n";
@@ -90,11 +112,17 @@ void printEquations(std::ostream& os, const Dae& dae, const sym::Context& ctx, c
     os << "\noutputs:\n";
     for (const auto& o : dae.outputs) os << "  " << o.name << " = " << sym::toString(ctx, o.value) << "\n";
   }
+  auto isConstraint = [](const Invariant& inv) { return inv.kind == "constraint residual"; };
   os << "\nfirst integrals:";
-  if (dae.invariants.empty()) os << " none (explicit time, dissipation or non-conservative forces)";
+  if (std::all_of(dae.invariants.begin(), dae.invariants.end(), isConstraint))
+    os << " none (explicit time, dissipation or non-conservative forces)";
   os << "\n";
   for (const auto& inv : dae.invariants)
-    os << "  " << inv.name << " (" << inv.kind << ", conserved) = " << sym::toString(ctx, inv.value) << "\n";
+    if (!isConstraint(inv)) os << "  " << inv.name << " (" << inv.kind << ", conserved) = " << sym::toString(ctx, inv.value) << "\n";
+  if (std::none_of(dae.invariants.begin(), dae.invariants.end(), isConstraint)) return;
+  os << "\nconstraint residuals (invariant columns, kept at 0 to the tolerance):\n";
+  for (const auto& inv : dae.invariants)
+    if (isConstraint(inv)) os << "  " << inv.name << " = " << sym::toString(ctx, inv.value) << "\n";
 }
 
 void printEquationsJson(std::ostream& os, const Dae& dae, const sym::Context& ctx, const SourceManager& sm) {

@@ -34,6 +34,7 @@ std::string originText(const Dae& dae, size_t i, const flat::Origin& o) {
     for (const Variable& v : dae.variables)
       if (v.flatVar == o.variable) s += " of " + v.name;
   if (!o.element.empty()) s += (o.kind == flat::OriginKind::Connection ? " " : " element ") + o.element;
+  if (o.differentiated > 0) s += ", differentiated " + std::to_string(o.differentiated) + "x";
   return s;
 }
 

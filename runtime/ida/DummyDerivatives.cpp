@@ -119,36 +119,37 @@ double conditionQuality(const Eigen::MatrixXd& H, const Eigen::MatrixXd& HS) {
 
 }  // namespace
 
+std::vector<int> DummyDerivativeModel::candidatesBelow(const std::vector<int>* chosenAbove) const {
+  std::vector<int> candidates;
+  if (!chosenAbove) {  // level 1: the chain tops, derivatives of which nothing is the derivative
+    for (int v = 0; v < static_cast<int>(full_.nVariables); ++v)
+      if (linkOfDerivative_[v] >= 0 &&
+          std::none_of(links_.begin(), links_.end(), [&](const Link& l) { return l.variable == v; }))
+        candidates.push_back(v);
+    return candidates;
+  }
+  for (int d : *chosenAbove) {  // one order lower, where that is itself a derivative
+    int below = links_[linkOfDerivative_[d]].variable;
+    if (linkOfDerivative_[below] >= 0) candidates.push_back(below);
+  }
+  return candidates;
+}
+
 std::vector<std::vector<int>> DummyDerivativeModel::bestChoice(double& quality) const {
   std::vector<std::vector<int>> choice;
   quality = 1;
-  std::vector<int> candidates;
-  for (int v = 0; v < static_cast<int>(full_.nVariables); ++v) {  // chain tops: a derivative, derivative of nothing
-    bool top = linkOfDerivative_[v] >= 0 &&
-               std::none_of(links_.begin(), links_.end(), [&](const Link& l) { return l.variable == v; });
-    if (top) candidates.push_back(v);
-  }
   for (int level = 1; level <= levels_; ++level) {
     std::vector<int> rows = levelRows(level);
+    std::vector<int> candidates = candidatesBelow(level == 1 ? nullptr : &choice.back());
     Eigen::MatrixXd H = submatrix(full_, jacobianYValues_, rows, candidates);
     Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(H);
     if (qr.rank() < static_cast<Eigen::Index>(rows.size()))
       throw std::runtime_error("the differentiated constraints cannot be solved for any of their derivatives "
                                "(the constraints are dependent here, or the mechanism is at a singular position)");
     std::vector<int> chosen;
-    Eigen::MatrixXd HS(H.rows(), H.rows());
-    for (Eigen::Index k = 0; k < H.rows(); ++k) {
-      Eigen::Index column = qr.colsPermutation().indices()[k];
-      chosen.push_back(candidates[column]);
-      HS.col(k) = H.col(column);
-    }
-    quality *= conditionQuality(H, HS);
+    for (Eigen::Index k = 0; k < H.rows(); ++k) chosen.push_back(candidates[qr.colsPermutation().indices()[k]]);
     std::sort(chosen.begin(), chosen.end());
-    candidates.clear();  // one order lower, where that is itself a derivative
-    for (int d : chosen) {
-      int below = links_[linkOfDerivative_[d]].variable;
-      if (linkOfDerivative_[below] >= 0) candidates.push_back(below);
-    }
+    quality *= conditionQuality(H, submatrix(full_, jacobianYValues_, rows, chosen));
     choice.push_back(std::move(chosen));
   }
   return choice;
@@ -160,8 +161,9 @@ double DummyDerivativeModel::qualityOf(const std::vector<std::vector<int>>& choi
     std::vector<int> rows = levelRows(level);
     const std::vector<int>& chosen = choice[level - 1];
     if (chosen.size() != rows.size()) return 0;
-    Eigen::MatrixXd HS = submatrix(full_, jacobianYValues_, rows, chosen);
-    quality *= conditionQuality(HS, HS);
+    std::vector<int> candidates = candidatesBelow(level == 1 ? nullptr : &choice[level - 2]);
+    quality *= conditionQuality(submatrix(full_, jacobianYValues_, rows, candidates),
+                                submatrix(full_, jacobianYValues_, rows, chosen));
   }
   return quality;
 }

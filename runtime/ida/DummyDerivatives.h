@@ -62,6 +62,8 @@ class DummyDerivativeModel {
 
   /// Rows of the equations differentiated at least `level` times, at their (c - level + 1)-th derivative.
   std::vector<int> levelRows(int level) const;
+  /// Level 1's candidates (chosenAbove null), or those one order below the dummies chosen a level up.
+  std::vector<int> candidatesBelow(const std::vector<int>* chosenAbove) const;
   /// Per level, the chosen derivatives (variables), best-conditioned first; and the choice's quality
   /// (product over levels of |det| / product of row norms, in [0, 1]).
   std::vector<std::vector<int>> bestChoice(double& quality) const;

@@ -83,6 +83,7 @@ struct IdaSession::Impl {
   N_Vector y = nullptr, yp = nullptr, id = nullptr, atol = nullptr;
   N_Vector yStep = nullptr, ypStep = nullptr;  ///< after index reduction: the solution at IDA's last step
   double tStep = 0;
+  SolverStats carried;  ///< counters of the integrations before the last restart (a new dummy choice)
   SUNMatrix matrix = nullptr;
   SUNLinearSolver solver = nullptr;
 
@@ -516,6 +517,7 @@ void IdaSession::Impl::useChoice(double time, N_Vector yv, N_Vector ypv) {
     const int32_t* l = full.derivativeLinks + 3 * k;
     if (model.isDifferential[l[1]]) data(ypv)[l[1]] = data(yv)[l[2]];
   }
+  carried = stats();  // IDAReInit resets IDA's counters
   check(IDAReInit(ida, time, yv, ypv), "IDAReInit");
   check(IDASetId(ida, id), "IDASetId");
   attachLinearSolver();
@@ -559,6 +561,15 @@ SolverStats IdaSession::Impl::stats() {
   check(IDAGetNumNonlinSolvConvFails(ida, &s.convergenceFailures), "IDAGetNumNonlinSolvConvFails");
   check(IDAGetLastStep(ida, &s.lastStep), "IDAGetLastStep");
   check(IDAGetLastOrder(ida, &s.lastOrder), "IDAGetLastOrder");
+  if (!dummies) return s;
+  s.steps += carried.steps;
+  s.residualEvaluations += carried.residualEvaluations;
+  s.jacobianEvaluations += carried.jacobianEvaluations;
+  s.nonlinearIterations += carried.nonlinearIterations;
+  s.errorTestFailures += carried.errorTestFailures;
+  s.convergenceFailures += carried.convergenceFailures;
+  s.dummyDerivatives = dummies->dummyNames();
+  s.dummyChanges = dummies->changes();
   return s;
 }
 

@@ -50,6 +50,8 @@ struct SolverStats {
   long convergenceFailures = 0;  ///< nonlinear solver convergence failures
   double lastStep = 0;           ///< last step size taken
   int lastOrder = 0;             ///< BDF order of the last step
+  std::string dummyDerivatives;  ///< after index reduction: the dummy derivatives at the end ("" if none)
+  int dummyChanges = 0;          ///< how often the run chose other dummy derivatives (IDA restarted)
 };
 
 /// A failed SUNDIALS call or model evaluation: message with the reason, and the simulation time.

@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 namespace qdot::rt {
 namespace {
 
@@ -31,7 +33,7 @@ std::optional<std::string> checkColumn(const QdotModel& m, uint32_t column) {
   if (begin > end) return fmt::format("Jacobian column {} has a negative length", column);
   for (int32_t k = begin; k < end; ++k) {
     int32_t row = m.jacobianRowIndices[k];
-    if (row < 0 || static_cast<uint32_t>(row) >= m.nResiduals)
+    if (row < 0 || static_cast<uint32_t>(row) >= std::max(m.nResiduals, m.nVariables))
       return fmt::format("Jacobian column {} has row index {} out of range", column, row);
     if (k > begin && row <= m.jacobianRowIndices[k - 1])
       return fmt::format("Jacobian column {} has row indices that are not strictly ascending", column);
@@ -46,7 +48,9 @@ std::optional<std::string> checkPattern(const QdotModel& m) {
   if (m.jacobianColumnStarts[0] != 0 ||
       m.jacobianColumnStarts[m.nVariables] != static_cast<int64_t>(m.jacobianNonzeros))
     return "its Jacobian column starts do not span the nonzeros";
-  if (m.nResiduals < m.nVariables) return "it has fewer residuals than variables";
+  if (m.nResiduals != 0 && m.nResiduals < m.nVariables) return "it has fewer residuals than variables";
+  if (m.nResiduals > m.nVariables && (m.nDerivativeLinks == 0 || m.nDifferentiatedEquations == 0))
+    return "it has more residuals than variables but no index reduction tables";
   for (uint32_t column = 0; column < m.nVariables; ++column)
     if (auto problem = checkColumn(m, column)) return problem;
   return std::nullopt;

@@ -30,6 +30,10 @@ std::string formatStats(const SimulationResult& r) {
   line(out, "linear solver",
        fmt::format("{} ({})", linearSolverName(r.linearSolver),
                    r.linearSolverChosenAutomatically ? "chosen automatically" : "as requested"));
+  if (!s.dummyDerivatives.empty())
+    line(out, "dummy derivatives",
+         fmt::format("{} (index reduction; chosen again {} time{} during the run)", s.dummyDerivatives, s.dummyChanges,
+                     s.dummyChanges == 1 ? "" : "s"));
   line(out, "initial values", r.computedInitialValues ? "made consistent by IDACalcIC" : "consistent as given");
   line(out, "tolerances", toleranceText(r.tolerances));
   line(out, "rows written", fmt::format("{}", r.rows));

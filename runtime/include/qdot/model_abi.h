@@ -48,7 +48,8 @@ struct QdotModel {
   /* F has nResiduals >= nVariables rows. Beyond nVariables they come from differentiated
    * equations (constraints): the runtime keeps all rows but one link per derivative of an
    * equation, chosen from the values (the dummy derivative method), and gives IDA that square
-   * system. Without index reduction nResiduals == nVariables and the tables are empty. */
+   * system. Without index reduction nResiduals == nVariables (0 means the same) and the tables
+   * are empty. */
   uint32_t nResiduals;
   uint32_t nDerivativeLinks;
   const int32_t* derivativeLinks;          /* [3*nDerivativeLinks]: row, variable, derivative */

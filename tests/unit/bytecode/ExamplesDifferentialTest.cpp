@@ -86,7 +86,7 @@ TEST_P(ExamplesTest, ParametersAndStartValuesMatchDirectEvaluation) {
 TEST_P(ExamplesTest, ResidualOutputsInvariantsMatchDirectEvaluation) {
   SourceModel m(GetParam(), readFile(GetParam()));
   ASSERT_TRUE(m.ok());
-  size_t n = m.model->nVariables, nOut = m.model->nOutputs;
+  size_t n = m.model->nVariables, rows = m.model->nResiduals, nOut = m.model->nOutputs;
   std::vector<sym::Expr> roots;  // residuals, outputs, invariants: the order the VM fills `all`
   for (const auto& e : m.dae->equations) roots.push_back(e.residual);
   for (const auto& o : m.dae->outputs) roots.push_back(o.value);
@@ -101,8 +101,8 @@ TEST_P(ExamplesTest, ResidualOutputsInvariantsMatchDirectEvaluation) {
     double t = uniform(0, 10);
     const QdotModel* q = m.model;
     ASSERT_EQ(q->residual(q, t, y.data(), yp.data(), p.data(), all.data()), 0) << q->lastError(q);
-    ASSERT_EQ(q->outputs(q, t, y.data(), yp.data(), p.data(), all.data() + n), 0) << q->lastError(q);
-    ASSERT_EQ(q->invariants(q, t, y.data(), yp.data(), p.data(), all.data() + n + nOut), 0) << q->lastError(q);
+    ASSERT_EQ(q->outputs(q, t, y.data(), yp.data(), p.data(), all.data() + rows), 0) << q->lastError(q);
+    ASSERT_EQ(q->invariants(q, t, y.data(), yp.data(), p.data(), all.data() + rows + nOut), 0) << q->lastError(q);
     std::vector<double> v = m.symbolValues(t, y, yp, p);
     magnitudes.update(v);
     for (size_t i = 0; i < roots.size(); ++i)
@@ -145,8 +145,8 @@ TEST_P(ExamplesTest, JacobianMatchesFiniteDifferences) {
   SourceModel m(GetParam(), readFile(GetParam()));
   ASSERT_TRUE(m.ok());
   const QdotModel* q = m.model;
-  size_t n = q->nVariables;
-  std::vector<double> p(q->nParameters), y(n), yp(n), J(q->jacobianNonzeros), Fp(n), Fm(n), fd(n * n, 0.0);
+  size_t n = q->nVariables, rows = q->nResiduals;  // rows > n after index reduction
+  std::vector<double> p(q->nParameters), y(n), yp(n), J(q->jacobianNonzeros), Fp(rows), Fm(rows), fd(n * rows, 0.0);
   ASSERT_EQ(q->parameters(q, nullptr, nullptr, p.data()), 0);
   for (int trial = 0; trial < 5; ++trial) {
     for (size_t j = 0; j < n; ++j) y[j] = uniform(-1.5, 1.5), yp[j] = uniform(-1.5, 1.5);
@@ -159,15 +159,15 @@ TEST_P(ExamplesTest, JacobianMatchesFiniteDifferences) {
         (*v)[j] = x + h, q->residual(q, t, y.data(), yp.data(), p.data(), Fp.data());
         (*v)[j] = x - h, q->residual(q, t, y.data(), yp.data(), p.data(), Fm.data());
         (*v)[j] = x;
-        for (size_t i = 0; i < n; ++i) fd[j * n + i] += factor * (Fp[i] - Fm[i]) / (2 * h);
+        for (size_t i = 0; i < rows; ++i) fd[j * rows + i] += factor * (Fp[i] - Fm[i]) / (2 * h);
       }
-    std::vector<double> dense(n * n, 0.0);
+    std::vector<double> dense(n * rows, 0.0);
     for (size_t j = 0; j < n; ++j)
       for (int32_t k = q->jacobianColumnStarts[j]; k < q->jacobianColumnStarts[j + 1]; ++k)
-        dense[j * n + q->jacobianRowIndices[k]] = J[k];
+        dense[j * rows + q->jacobianRowIndices[k]] = J[k];
     for (size_t j = 0; j < n; ++j)
-      for (size_t i = 0; i < n; ++i)
-        EXPECT_NEAR(dense[j * n + i], fd[j * n + i], 1e-6 * std::max({1.0, std::fabs(fd[j * n + i]), cj}))
+      for (size_t i = 0; i < rows; ++i)
+        EXPECT_NEAR(dense[j * rows + i], fd[j * rows + i], 1e-6 * std::max({1.0, std::fabs(fd[j * rows + i]), cj}))
             << "row " << i << " column " << j << " (" << q->variableNames[j] << "), cj " << cj;
   }
 }

@@ -95,7 +95,7 @@ TEST_P(JitExamplesTest, AgreesWithTheKernelInterpreter) {
 
   // State functions at random states.
   for (int trial = 0; trial < 8; ++trial) {
-    std::vector<double> y = randoms(n, -1.5, 1.5), yp = randoms(n, -2, 2), F(n), J(q->jacobianNonzeros);
+    std::vector<double> y = randoms(n, -1.5, 1.5), yp = randoms(n, -2, 2), F(q->nResiduals), J(q->jacobianNonzeros);
     std::vector<double> out(q->nOutputs), inv(q->nInvariants);
     double t = uniform(0, 10), cj = uniform(0.1, 100);
     ModelCall in;

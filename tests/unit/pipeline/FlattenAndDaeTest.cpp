@@ -3,6 +3,8 @@
 // each checked by evaluating the flat equations at chosen values against hand-computed numbers.
 #include "CompiledModel.h"
 
+#include <algorithm>
+
 namespace qdot::test {
 namespace {
 
@@ -187,7 +189,19 @@ mechanics
   constraint x^2 + y^2 = l^2;
 end CartesianPendulum;)");
   ASSERT_TRUE(m.ok());
-  ASSERT_EQ(m.dae().variables.back().name, "lambda[1]");
+  const dae::Dae& d = m.dae();
+  auto multiplier = std::find_if(d.variables.begin(), d.variables.end(), [](const dae::Variable& v) {
+    return v.role == dae::UnknownRole::Multiplier;
+  });
+  ASSERT_NE(multiplier, d.variables.end());
+  EXPECT_EQ(multiplier->name, "lambda[1]");
+  // Index reduction: the constraint is differentiated twice (Pantelides), the accelerations are
+  // unknowns with link rows, and two of the four links are dropped at run time: 9 rows, 7 unknowns.
+  ASSERT_EQ(d.differentiatedRows.size(), 1u);
+  EXPECT_EQ(d.differentiatedRows[0].size(), 3u);
+  EXPECT_EQ(d.links.size(), 4u);
+  EXPECT_EQ(d.equations.size(), d.variables.size() + d.dummyDerivativeCount());
+  EXPECT_EQ(d.dummyDerivativeCount(), 2u);
   m.set("m", 2), m.set("g", 9.81), m.set("l", 1), m.set("x", 0.6), m.set("y", -0.8), m.set("der(x)", 0.1),
       m.set("der(y)", 0.2), m.set("der(der(x))", 1.5), m.set("der(der(y))", -0.5), m.set("lambda[1]", 3);
   // m ẍ − λ·2x = 0 and m ÿ + m g − λ·2y = 0
