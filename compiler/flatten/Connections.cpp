@@ -279,6 +279,7 @@ void Flattener::keepStart(int var, int rep, Expr value) {
   if (rep >= 0 && !other) {
     out_.variables[rep].start = v.start;
     out_.variables[rep].fixed = v.fixed || out_.variables[rep].fixed;
+    out_.variables[rep].fixedGiven = v.fixedGiven || out_.variables[rep].fixedGiven;
     return;
   }
   if (other == v.start) return;

@@ -33,6 +33,7 @@ struct Variable {
   std::string_view name;  ///< user-facing scalar name: `th[1]`, `der(th[1])` (the symbol's name)
   VarRole role = VarRole::Unknown;
   bool fixed = false;
+  bool fixedGiven = false;  ///< `fixed` written by the user (else a default: a coordinate's start is fixed)
   bool input = false;  ///< Parameter: an `input` of the model (value 0 unless set; B of `qdot linearize`)
   sym::Expr symbol = nullptr;
   SourceRange declRange;  ///< the declaration's name (or the der() that created it)

@@ -404,7 +404,7 @@ void Flattener::applyAttributeList(const std::vector<ast::Modification>& mods, c
       else if (mod.name == "min") var.min = x;
       else if (mod.name == "max") var.max = x;
       else if (!x->isConstant()) fail(mod.value->range, DiagCode::E0303, "'fixed' must be true or false");
-      else var.fixed = x->value != 0;
+      else var.fixed = x->value != 0, var.fixedGiven = true;
     }
   }
 }

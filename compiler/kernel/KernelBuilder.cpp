@@ -7,6 +7,7 @@
 #include <limits>
 #include <unordered_set>
 
+#include "dae/Initialization.h"
 #include "kernel/Jacobian.h"
 #include "kernel/Lowering.h"
 #include "support/Diagnostic.h"
@@ -207,6 +208,8 @@ class Builder {
   // --- start values ----------------------------------------------------------------------------
 
   std::unordered_map<size_t, size_t> initialEquationOf_;  ///< variable → the initial equation that sets it
+  std::vector<dae::StartUse> startUse_;                   ///< per variable: what its start value is
+  std::vector<dae::Equation> initialRows_;                ///< initial equations that are not start values
 
   struct Start {
     Expr y0 = nullptr, yp0 = nullptr;
@@ -231,11 +234,11 @@ class Builder {
       if (!target->isSymbol() || !overParameters(value)) continue;
       for (size_t j = 0; j < dae_.variables.size(); ++j) {
         const auto& v = dae_.variables[j];
-        if (v.y != target && v.yp != target) continue;
-        if (!acceptInitialEquation(e, i, j, v.y == target)) return true;  // reported
+        if (v.y != target) continue;  // a derivative's value is a condition of the initialization system
+        if (!acceptInitialEquation(e, i, j, true)) return true;  // reported
         uint32_t src = addSource("initial equation " + std::to_string(i + 1), e.origin.range, equationText(e));
-        if (v.y == target) starts[j].y0 = value, starts[j].source = src, m_.description.fixed[j] = 1;
-        else starts[j].yp0 = value, starts[j].derivativeSource = src;
+        starts[j].y0 = value, starts[j].source = src, m_.description.fixed[j] = 1;
+        startUse_[j] = dae::StartUse::Required;
         return true;
       }
     }
@@ -249,14 +252,6 @@ class Builder {
   bool acceptInitialEquation(const dae::Equation& e, size_t i, size_t j, bool value) {
     const auto& v = dae_.variables[j];
     SourceRange at = e.origin.range.valid() ? e.origin.range : dae_.range;
-    if (!value) {
-      diags_.error(at, DiagCode::E0603,
-                   "this initial equation sets the derivative of '" + v.name +
-                       "', which the equations of motion determine at the start",
-                   "set '" + v.name + "' itself (its start value or an initial equation for it); initial "
-                   "conditions on derivatives of states are not supported yet");
-      return false;
-    }
     auto [it, first] = initialEquationOf_.try_emplace(j, i);
     if (!first) {
       auto& d = diags_.error(at, DiagCode::E0604, "the initial value of '" + v.name + "' is given twice",
@@ -264,7 +259,7 @@ class Builder {
       d.notes.push_back({dae_.initialEquations[it->second].origin.range, "first given here"});
       return false;
     }
-    if (v.declaration.start && v.declaration.fixed && v.role != dae::UnknownRole::Velocity) {
+    if (v.declaration.start && v.declaration.fixed && v.declaration.fixedGiven) {
       auto& d = diags_.error(at, DiagCode::E0604,
                              "'" + v.name + "' has a fixed start value and this initial equation as well",
                              "remove one of the two, or declare the start a guess: " + v.name + "(start = ..., fixed = false)");
@@ -281,16 +276,33 @@ class Builder {
       starts[j].y0 = v.declaration.start;
       if (v.declaration.start) starts[j].source = addSource("start value of " + v.name, v.declaration.declRange);
     }
+    startUse_.resize(dae_.variables.size());
+    for (size_t j = 0; j < dae_.variables.size(); ++j) {  // as written (fixed = …), else the default
+      const flat::Variable& d = dae_.variables[j].declaration;
+      startUse_[j] = d.fixedGiven ? (d.fixed ? dae::StartUse::Required : dae::StartUse::Guess)
+                     : m_.description.fixed[j] ? dae::StartUse::Default
+                                               : dae::StartUse::Guess;
+    }
     for (size_t i = 0; i < dae_.initialEquations.size(); ++i)
-      if (!applyInitialEquation(i, starts)) reportImplicitInitialEquation(dae_.initialEquations[i]);
+      if (!applyInitialEquation(i, starts)) initialRows_.push_back(dae_.initialEquations[i]);
+    if (!initialRows_.empty()) planInitialRows();
     return starts;
   }
 
-  void reportImplicitInitialEquation(const dae::Equation& e) {
-    diags_.error(e.origin.range.valid() ? e.origin.range : dae_.range, DiagCode::E0601,
-                 "an initial equation must read v = expression or der(v) = expression, over parameters",
-                 "solve it for the variable by hand, e.g. x = sqrt(4) instead of x^2 = 4, or give the variable a "
-                 "start value: Real x(start = 2)");
+  // Initial equations that are not start values are rows of F used only at t0 (the run's initial
+  // Newton solve); the starts they replace are computed instead of kept.
+  void planInitialRows() {
+    if (!dae_.differentiatedRows.empty()) {
+      for (const auto& e : initialRows_)
+        diags_.error(e.origin.range.valid() ? e.origin.range : dae_.range, DiagCode::E0601,
+                     "in a model with constraints an initial equation must read v = expression over parameters",
+                     "give the start values of the coordinates and velocities instead (those the constraints make "
+                     "dependent are computed)");
+      return;
+    }
+    std::optional<std::vector<char>> kept = dae::planInitialization(dae_, initialRows_, startUse_, ctx_, diags_);
+    if (!kept) return;
+    for (size_t j = 0; j < kept->size(); ++j) m_.description.fixed[j] = (*kept)[j];
   }
 
   // out = [y0 (n), yp0 (n), nominal (n)]; stores of a plain 0 serve no source.
@@ -318,15 +330,23 @@ class Builder {
 
   void buildResidualAndJacobian() {
     Expr cj = ctx_.symbol("$cj");
-    JacobianEntries jac = differentiate(dae_, ctx_, cj);
+    JacobianEntries jac = initialRows_.empty() ? differentiate(dae_, ctx_, cj) : differentiate(withInitialRows(), ctx_, cj);
     m_.description.jacobianColumnStarts = jac.columnStarts;
     m_.description.jacobianRowIndices = jac.rowIndices;
     std::vector<Expr> roots;
     for (const auto& e : dae_.equations) roots.push_back(e.residual);
+    for (size_t k = 0; k < initialRows_.size(); ++k) {  // after every DAE row: rows used only at t0
+      const auto& e = initialRows_[k];
+      auto row = static_cast<int32_t>(dae_.equations.size() + k);
+      m_.description.initialRows.push_back(row);
+      m_.description.initialRowLabels.push_back("initial equation " + equationText(e));
+      equationSource_.push_back(addSource("initial equation (t0 only)", e.origin.range, equationText(e)));
+      roots.push_back(e.residual);
+    }
     roots.insert(roots.end(), jac.values.begin(), jac.values.end());
     sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, roots, "$t");
     m_.sharedTemporaries = cse.temporaries.size();
-    size_t n = dae_.equations.size();
+    size_t n = dae_.equations.size() + initialRows_.size();
 
     ProgramBuilder res(programName(ModelProgram::Residual));
     bindInputs(res, true);
@@ -343,6 +363,12 @@ class Builder {
       jb.store(k, jb.lower(cse.outputs[n + k]));
     }
     m_.program(ModelProgram::Jacobian) = jb.finish(static_cast<uint32_t>(jac.values.size()));
+  }
+
+  dae::Dae withInitialRows() const {
+    dae::Dae d = dae_;
+    d.equations.insert(d.equations.end(), initialRows_.begin(), initialRows_.end());
+    return d;
   }
 
   // --- outputs and invariants --------------------------------------------------------------------

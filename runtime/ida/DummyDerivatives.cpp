@@ -171,6 +171,7 @@ double DummyDerivativeModel::qualityOf(const std::vector<std::vector<int>>& choi
 void DummyDerivativeModel::apply(const std::vector<std::vector<int>>& choice) {
   const uint32_t n = full_.nVariables;
   std::vector<char> dropped(full_.nResiduals, 0);
+  for (uint32_t r = full_.nResiduals - full_.nInitialRows; r < full_.nResiduals; ++r) dropped[r] = 1;  // t0 only
   isDifferential_.assign(full_.isDifferential, full_.isDifferential + n);
   for (const Link& l : links_) isDifferential_[l.variable] = 1;
   for (const auto& level : choice)
@@ -205,12 +206,19 @@ bool DummyDerivativeModel::choose(double t, const double* y, const double* yp, c
                              modelLastError(full_));
   double bestQuality = 0;
   std::vector<std::vector<int>> candidate = bestChoice(bestQuality);
-  if (candidate == choice_) return false;
+  if (applied_ && candidate == choice_) return false;
   if (!choice_.empty() && !best && qualityOf(choice_) >= kSwitchRatio * bestQuality) return false;
   apply(candidate);
   choice_ = std::move(candidate);
   ++changes_;
+  applied_ = true;
   return true;
+}
+
+std::vector<char> DummyDerivativeModel::keptRows() const {
+  std::vector<char> kept(squareRowOf_.size());
+  for (size_t r = 0; r < kept.size(); ++r) kept[r] = squareRowOf_[r] >= 0;
+  return kept;
 }
 
 std::string DummyDerivativeModel::dummyNames() const {

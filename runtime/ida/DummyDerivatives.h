@@ -1,5 +1,6 @@
 // DummyDerivativeModel: the square system IDA integrates for a model whose index was reduced
-// (compiler/dae/IndexReduction.h). The compiled residual has more rows than unknowns: every
+// (compiler/dae/IndexReduction.h), or whose F has rows used only at t0 (initial equations: always
+// left out here). The compiled residual has more rows than unknowns: every
 // equation, its differentiated forms and every link row der(x) = x1 of the derivative chains. The
 // dummy derivative method (Mattsson & Söderlind 1993) keeps all rows but one link per derivative of
 // an equation: the dropped link's derivative is a "dummy" (an algebraic unknown) and its variable
@@ -45,6 +46,8 @@ class DummyDerivativeModel {
   /// constraints are dependent there) or the Jacobian cannot be evaluated.
   bool choose(double t, const double* y, const double* yp, const double* p, bool best);
 
+  /// Per row of the full model: whether the square model keeps it.
+  std::vector<char> keptRows() const;
   /// The current dummy derivatives, e.g. "der(y), der(der(y))".
   std::string dummyNames() const;
   /// How many times choose() changed the choice after the first one.
@@ -84,6 +87,7 @@ class DummyDerivativeModel {
   std::vector<int32_t> fullEntryOf_;      // square nonzero -> full nonzero
   mutable std::vector<double> scratchF_, scratchJ_;
   int changes_ = -1;
+  bool applied_ = false;
 };
 
 }  // namespace qdot::rt

@@ -18,6 +18,7 @@
 
 #include "ida/DummyDerivatives.h"
 #include "ida/IdaFlags.h"
+#include "ida/InitialSystem.h"
 #include "ida/ModelCheck.h"
 
 namespace qdot::rt {
@@ -121,6 +122,8 @@ struct IdaSession::Impl {
   void estimateAlgebraicRates(double tout1);
   void checkStartMatrix();
   bool chooseDummyDerivatives(double time, N_Vector yv, N_Vector ypv, bool best);
+  void solveInitialConditions();
+  int initialNewtonIterations = -1;  ///< -1: no initialization system was solved
   /// The compiled model (with all rows, before the dummy derivative choice).
   const QdotModel& fullModel() const { return dummies ? *reinterpret_cast<const SquareTable*>(&model)->full : model; }
   void useChoice(double time, N_Vector yv, N_Vector ypv);
@@ -471,6 +474,7 @@ void IdaSession::Impl::checkStartMatrix() {
 
 void IdaSession::Impl::initialize(double tout1) {
   if (n == 0) return;
+  if (fullModel().nInitialRows > 0) solveInitialConditions();
   checkStartMatrix();
   bool hasAlgebraic = std::any_of(model.isDifferential, model.isDifferential + n, [](int32_t d) { return d == 0; });
   if (!hasAlgebraic && startIsConsistent()) return;
@@ -494,6 +498,22 @@ void IdaSession::Impl::initialize(double tout1) {
     N_VScale(1.0, yp, ypStep);
     tStep = options.t0;
   }
+}
+
+// Initial equations that are not start values: the whole initialization system by Newton, then a
+// restart from its solution (IDACalcIC after it finds nothing to change).
+void IdaSession::Impl::solveInitialConditions() {
+  std::vector<int32_t> fixed(n, 0);
+  if (model.fixedStarts) model.fixedStarts(&model, fixed.data());
+  try {
+    InitialSystemResult r =
+        solveInitialSystem(fullModel(), dummies->keptRows(), model.isDifferential, fixed.data(), p.data(), options.t0,
+                           data(y), data(yp));
+    initialNewtonIterations = r.iterations;
+  } catch (const std::runtime_error& e) {
+    throw IdaError(fmt::format("at t = {:.10g}: {}", options.t0, e.what()), options.t0);
+  }
+  check(IDAReInit(ida, options.t0, y, yp), "IDAReInit");
 }
 
 // --- dummy derivatives (index reduction) ------------------------------------------------------
@@ -569,6 +589,7 @@ SolverStats IdaSession::Impl::stats() {
   s.errorTestFailures += carried.errorTestFailures;
   s.convergenceFailures += carried.convergenceFailures;
   s.dummyDerivatives = dummies->dummyNames();
+  s.initialNewtonIterations = initialNewtonIterations;
   s.dummyChanges = dummies->changes();
   return s;
 }

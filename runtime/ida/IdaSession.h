@@ -52,6 +52,7 @@ struct SolverStats {
   int lastOrder = 0;             ///< BDF order of the last step
   std::string dummyDerivatives;  ///< after index reduction: the dummy derivatives at the end ("" if none)
   int dummyChanges = 0;          ///< how often the run chose other dummy derivatives (IDA restarted)
+  int initialNewtonIterations = -1;  ///< Newton iterations of the initialization system (-1: none solved)
 };
 
 /// A failed SUNDIALS call or model evaluation: message with the reason, and the simulation time.

@@ -49,7 +49,7 @@ std::optional<std::string> checkPattern(const QdotModel& m) {
       m.jacobianColumnStarts[m.nVariables] != static_cast<int64_t>(m.jacobianNonzeros))
     return "its Jacobian column starts do not span the nonzeros";
   if (m.nResiduals != 0 && m.nResiduals < m.nVariables) return "it has fewer residuals than variables";
-  if (m.nResiduals > m.nVariables && (m.nDerivativeLinks == 0 || m.nDifferentiatedEquations == 0))
+  if (m.nResiduals > m.nVariables + m.nInitialRows && (m.nDerivativeLinks == 0 || m.nDifferentiatedEquations == 0))
     return "it has more residuals than variables but no index reduction tables";
   for (uint32_t column = 0; column < m.nVariables; ++column)
     if (auto problem = checkColumn(m, column)) return problem;

@@ -34,7 +34,10 @@ std::string formatStats(const SimulationResult& r) {
     line(out, "dummy derivatives",
          fmt::format("{} (index reduction; chosen again {} time{} during the run)", s.dummyDerivatives, s.dummyChanges,
                      s.dummyChanges == 1 ? "" : "s"));
-  line(out, "initial values", r.computedInitialValues ? "made consistent by IDACalcIC" : "consistent as given");
+  if (s.initialNewtonIterations >= 0)
+    line(out, "initial values", fmt::format("initialization system solved ({} Newton iterations)", s.initialNewtonIterations));
+  else
+    line(out, "initial values", r.computedInitialValues ? "made consistent by IDACalcIC" : "consistent as given");
   line(out, "tolerances", toleranceText(r.tolerances));
   line(out, "rows written", fmt::format("{}", r.rows));
   line(out, "wall time", fmt::format("setup {:.3f} s, solve {:.3f} s", r.setupSeconds, r.solveSeconds));

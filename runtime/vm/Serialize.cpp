@@ -114,8 +114,9 @@ void writeDescription(Writer& w, const ModelDescription& d) {
                             &d.invariantNames, &d.structuralParameters})
     w.strings(*names);
   for (const auto* ints : {&d.isDifferential, &d.fixed, &d.jacobianColumnStarts, &d.jacobianRowIndices,
-                           &d.derivativeLinks, &d.differentiatedRowStarts, &d.differentiatedRows})
+                           &d.derivativeLinks, &d.differentiatedRowStarts, &d.differentiatedRows, &d.initialRows})
     w.words(*ints);
+  w.strings(d.initialRowLabels);
 }
 
 ModelDescription readDescription(Reader& r) {
@@ -125,8 +126,9 @@ ModelDescription readDescription(Reader& r) {
                       &d.invariantNames, &d.structuralParameters})
     *names = r.strings();
   for (auto* ints : {&d.isDifferential, &d.fixed, &d.jacobianColumnStarts, &d.jacobianRowIndices,
-                     &d.derivativeLinks, &d.differentiatedRowStarts, &d.differentiatedRows})
+                     &d.derivativeLinks, &d.differentiatedRowStarts, &d.differentiatedRows, &d.initialRows})
     *ints = r.words<int32_t>();
+  d.initialRowLabels = r.strings();
   return d;
 }
 

@@ -56,6 +56,10 @@ struct QdotModel {
   uint32_t nDifferentiatedEquations;
   const int32_t* differentiatedRowStarts;  /* [nDifferentiatedEquations + 1] into differentiatedRows */
   const int32_t* differentiatedRows;       /* rows of e, e', e'', … per differentiated equation */
+  /* The last nInitialRows rows of F hold only at t0: initial equations that are not start values.
+   * The runtime solves them with the other rows at the start and leaves them out afterwards. */
+  uint32_t nInitialRows;
+  const char* const* initialRowLabels;     /* [nInitialRows], e.g. "initial equation x + der(x) = 3" */
 
   /* --- functions ---------------------------------------------------------------------------- */
   /* Parameter values: p[i] = overridden[i] ? given[i] : default binding of parameter i, evaluated

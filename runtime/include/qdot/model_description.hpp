@@ -30,6 +30,10 @@ struct ModelDescription {
   /// residualCount() rows; the run time keeps all but dummyDerivativeCount() links.
   std::vector<int32_t> derivativeLinks;
   std::vector<int32_t> differentiatedRowStarts, differentiatedRows;
+  /// Rows of F that hold only at t0 (initial equations that are not start values), the last rows,
+  /// with a label each for messages ("initial equation x + der(x) = 3").
+  std::vector<int32_t> initialRows;
+  std::vector<std::string> initialRowLabels;
 
   size_t variableCount() const { return variableNames.size(); }
   size_t parameterCount() const { return parameterNames.size(); }
@@ -39,8 +43,8 @@ struct ModelDescription {
   }
   /// Derivatives of equations in the system: as many links are dropped (dummy derivatives).
   size_t dummyDerivativeCount() const { return differentiatedRows.size() - differentiatedEquationCount(); }
-  /// Rows of F: one per variable, plus one per dummy derivative.
-  size_t residualCount() const { return variableCount() + dummyDerivativeCount(); }
+  /// Rows of F: one per variable, plus one per dummy derivative, plus the initial rows.
+  size_t residualCount() const { return variableCount() + dummyDerivativeCount() + initialRows.size(); }
 
   /// How many values program `p` writes for this model (initialValues: y0, yp0 and nominal).
   size_t outputCount(ModelProgram p) const {
@@ -84,6 +88,10 @@ struct ModelDescription {
     for (size_t k = 0; k + 1 < starts.size(); ++k)
       if (starts[k + 1] - starts[k] < 2) return "a differentiated equation has fewer than two rows";
     size_t rowsEnd = residualCount();
+    if (initialRowLabels.size() != initialRows.size()) return "initial rows and their labels differ in number";
+    for (size_t k = 0; k < initialRows.size(); ++k)
+      if (static_cast<size_t>(initialRows[k]) != residualCount() - initialRows.size() + k)
+        return "the initial rows are not the last rows";
     for (int32_t r : differentiatedRows)
       if (r < 0 || static_cast<size_t>(r) >= rowsEnd) return "a differentiated row is out of range";
     for (size_t k = 0; k < derivativeLinks.size(); k += 3)

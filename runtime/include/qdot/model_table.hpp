@@ -13,7 +13,7 @@ namespace qdot {
 
 /// The C-string arrays a QdotModel points into; lives beside the model (and its description).
 struct ModelNameTable {
-  std::vector<const char*> variables, parameters, parameterDescriptions, outputs, invariants;
+  std::vector<const char*> variables, parameters, parameterDescriptions, outputs, invariants, initialRows;
 };
 
 /// Points `m` at the names and pattern of `d`, which (like `names`) must outlive `m`.
@@ -25,7 +25,7 @@ inline void fillModelTable(QdotModel& m, ModelNameTable& names, const ModelDescr
     return out;
   };
   names = {cStrings(d.variableNames), cStrings(d.parameterNames), cStrings(d.parameterDescriptions),
-           cStrings(d.outputNames), cStrings(d.invariantNames)};
+           cStrings(d.outputNames), cStrings(d.invariantNames), cStrings(d.initialRowLabels)};
   m.abiVersion = QDOT_MODEL_ABI_VERSION;
   m.name = d.name.c_str();
   m.nVariables = static_cast<uint32_t>(d.variableNames.size());
@@ -47,6 +47,8 @@ inline void fillModelTable(QdotModel& m, ModelNameTable& names, const ModelDescr
   m.nDifferentiatedEquations = static_cast<uint32_t>(d.differentiatedEquationCount());
   m.differentiatedRowStarts = d.differentiatedRowStarts.data();
   m.differentiatedRows = d.differentiatedRows.data();
+  m.nInitialRows = static_cast<uint32_t>(d.initialRows.size());
+  m.initialRowLabels = names.initialRows.data();
 }
 
 }  // namespace qdot

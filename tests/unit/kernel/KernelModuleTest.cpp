@@ -130,24 +130,38 @@ TEST(Kernel, StartValuesNominalsAndFixedFlags) {
   EXPECT_EQ(m.description.isDifferential, (std::vector<int32_t>{1, 1}));
 }
 
-TEST(Kernel, ExplicitInitialEquationsSetStarts) {
+// Initial equations: `v = expression` over parameters sets a start value (then fixed); any other
+// (here on an acceleration) is a row of F used only at t0, replacing a start that was fixed only by
+// default (x's); one condition too many is E0606.
+void addInitial(TinyDae& d, sym::Expr lhs, sym::Expr rhs) {
+  dae::Equation e;
+  e.lhs = lhs, e.rhs = rhs, e.residual = d.ctx.sub(lhs, rhs);
+  e.origin.kind = flat::OriginKind::InitialEquation;
+  d.dae.initialEquations.push_back(e);
+}
+
+TEST(Kernel, ExplicitInitialEquationsSetStartsOthersBecomeRows) {
   TinyDae d;
-  auto initial = [&](sym::Expr lhs, sym::Expr rhs) {
-    dae::Equation e;
-    e.lhs = lhs, e.rhs = rhs, e.residual = d.ctx.sub(lhs, rhs);
-    e.origin.kind = flat::OriginKind::InitialEquation;
-    d.dae.initialEquations.push_back(e);
-  };
-  initial(d.v, d.ctx.mul(d.ctx.constant(2), d.m));  // der(x) = 2*m: the velocity's start
-  initial(d.ctx.constant(5), d.a);                    // 5 = der(der(x)): refused, the EL row decides it
-  initial(d.ctx.add(d.x, d.v), d.ctx.one());          // not explicit: unsupported
+  addInitial(d, d.v, d.ctx.mul(d.ctx.constant(2), d.m));  // der(x) = 2*m: the velocity's start
+  addInitial(d, d.ctx.constant(5), d.a);                    // 5 = der(der(x)): a condition at t0
   kernel::KernelModule m = kernel::buildKernels(d.dae, d.ctx, d.diags);
-  ASSERT_EQ(d.diags.errorCount(), 2u);
-  EXPECT_EQ(d.diags.diagnostics()[0].code, DiagCode::E0603);
-  EXPECT_EQ(d.diags.diagnostics()[1].code, DiagCode::E0601);
+  ASSERT_EQ(d.diags.errorCount(), 0u);
   std::vector<double> p = {3.0, 1.5}, out(6);
   kernel::interpret(m.program(ModelProgram::InitialValues), {.p = p.data()}, out);
-  EXPECT_EQ(out, (std::vector<double>{1.5, 3.0, 0, 0, 0, 0}));  // the velocity's derivative is not set
+  EXPECT_EQ(out, (std::vector<double>{1.5, 3.0, 0, 0, 0, 0}));
+  EXPECT_EQ(m.description.fixed, (std::vector<int32_t>{0, 1}));  // x is computed from der(der(x)) = 5
+  EXPECT_EQ(m.description.initialRows, (std::vector<int32_t>{2}));
+  EXPECT_EQ(m.description.residualCount(), 3u);
+}
+
+TEST(Kernel, OverDeterminedInitialConditionsAreNamed) {
+  TinyDae d;
+  addInitial(d, d.v, d.ctx.mul(d.ctx.constant(2), d.m));
+  addInitial(d, d.ctx.constant(5), d.a);
+  addInitial(d, d.ctx.add(d.x, d.v), d.ctx.one());  // a third condition on two states
+  kernel::KernelModule m = kernel::buildKernels(d.dae, d.ctx, d.diags);
+  ASSERT_EQ(d.diags.errorCount(), 1u);
+  EXPECT_EQ(d.diags.diagnostics()[0].code, DiagCode::E0606);
 }
 
 TEST(Kernel, SymbolsThatAreNotInputsAreReported) {

@@ -1,0 +1,51 @@
+// The initialization system (issue 10 §2) end to end: implicit initial equations, a condition on an
+// acceleration, steady state and a nonlinear condition, each against its closed-form solution at
+// every output time (the conditions fix the constants of the textbook solution).
+#include <cmath>
+
+#include "QdotRun.h"
+
+namespace qdot::simtest {
+namespace {
+
+constexpr double kRtol = 1e-8;
+
+RunResult run(const std::string& name, double stop) {
+  auto r = runQdot("tests/sim/models/" + name + ".qd", {"--rtol", num(kRtol), "--stop", num(stop), "--stats"});
+  EXPECT_EQ(r.exitCode, 0) << r.log;
+  EXPECT_NE(r.log.find("initialization system solved"), std::string::npos) << r.log;
+  return r;
+}
+
+// |column - exact| <= 100 rtol (|exact| + scale) at every row.
+void expectColumn(const RunResult& r, const std::string& name, const std::function<double(double)>& exact, double scale) {
+  const auto &t = r.time(), &v = r.col(name);
+  ASSERT_FALSE(v.empty());
+  for (size_t i = 0; i < v.size(); ++i)
+    ASSERT_NEAR(v[i], exact(t[i]), 100 * kRtol * (std::abs(exact(t[i])) + scale)) << name << " at t = " << t[i];
+}
+
+TEST(Initialization, ImplicitInitialEquation) {
+  RunResult r = run("init_implicit", 2);
+  expectColumn(r, "x", [](double t) { return -3 * std::exp(-2 * t); }, 3);
+}
+
+TEST(Initialization, ConditionOnTheAcceleration) {
+  RunResult r = run("init_acceleration", 5);
+  expectColumn(r, "x", [](double t) { return -1.25 * std::cos(2 * t); }, 1.25);
+  expectColumn(r, "der(x)", [](double t) { return 2.5 * std::sin(2 * t); }, 2.5);
+}
+
+TEST(Initialization, SteadyState) {
+  RunResult r = run("init_steady", 5);
+  expectColumn(r, "x", [](double) { return 0.5; }, 0.5);
+  expectColumn(r, "der(x)", [](double) { return 0.0; }, 0.5);
+}
+
+TEST(Initialization, NonlinearConditionFromTheStartGuess) {
+  RunResult r = run("init_nonlinear", 5);
+  expectColumn(r, "x", [](double t) { return 2 * std::cos(t); }, 2);
+}
+
+}  // namespace
+}  // namespace qdot::simtest
