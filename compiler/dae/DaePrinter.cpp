@@ -125,6 +125,15 @@ void printEquations(std::ostream& os, const Dae& dae, const sym::Context& ctx, c
     if (isConstraint(inv)) os << "  " << inv.name << " = " << sym::toString(ctx, inv.value) << "\n";
 }
 
+// A start is fixed when an initial equation sets it or `fixed = true` is written; `fixed = false`
+// makes it a guess; otherwise a state's start is fixed by default (initial equations that are not
+// start values may replace it: the initialization system decides, kernel stage).
+bool startIsFixed(const Variable& v, sym::Expr initial) {
+  if (initial) return true;
+  if (v.declaration.fixedGiven) return v.declaration.fixed;
+  return v.kind == VarKind::State || v.declaration.fixed;
+}
+
 void printEquationsJson(std::ostream& os, const Dae& dae, const sym::Context& ctx, const SourceManager& sm) {
   auto str = [&](sym::Expr e) { return jsonString(sym::toString(ctx, e)); };
   os << "{\n  \"model\": " << jsonString(dae.name) << ",\n  \"description\": " << jsonString(dae.description)
@@ -155,7 +164,7 @@ void printEquationsJson(std::ostream& os, const Dae& dae, const sym::Context& ct
        << jsonString(v.kind == VarKind::State ? "state" : "algebraic") << ", \"role\": " << jsonString(roleName(v.role))
        << (start ? ", \"start\": " + str(start) : std::string())
        << (start ? std::string(", \"startFrom\": ") + (initial ? "\"initial equation\"" : "\"start\"") : std::string())
-       << (start ? std::string(", \"fixed\": ") + (initial || v.kind == VarKind::State || v.declaration.fixed ? "true" : "false") : std::string())
+       << (start ? std::string(", \"fixed\": ") + (startIsFixed(v, initial) ? "true" : "false") : std::string())
        << "}";
   }
   os << "\n  ],\n  \"parameters\": [";
