@@ -3,6 +3,7 @@
 // (correctness asserted, time printed).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <map>
@@ -209,6 +210,47 @@ struct Oracle {
   }
 };
 
+// Per class: a fixed start if any member has one, else the representative's own, else the lowest
+// member's; every member's start is the chosen one through its sign; each member whose own start
+// differs is reported once.
+void expectStartsChosenByTheRule(const AliasProblem& p, const AliasResult& r) {
+  std::map<int, std::vector<int>> classes;
+  for (int v = 0; v < p.numVariables; ++v) classes[r.representative[v]].push_back(v);
+  size_t reported = 0;
+  for (const auto& [rep, members] : classes) {
+    auto asRep = [&](int v) { return p.start[v] ? std::optional<double>(r.sign[v] * p.start[v]->value) : std::nullopt; };
+    std::vector<int> given;
+    for (int v : members)
+      if (p.start[v]) given.push_back(v);
+    if (r.constant[rep]) {
+      for (int v : given) reported += p.start[v]->value != *r.constant[v];
+      continue;
+    }
+    if (given.empty()) {
+      ASSERT_EQ(r.startFrom[rep], -1);
+      continue;
+    }
+    int from = r.startFrom[rep];
+    ASSERT_TRUE(std::find(given.begin(), given.end(), from) != given.end());
+    bool anyFixed = std::any_of(given.begin(), given.end(), [&](int v) { return p.start[v]->fixed; });
+    ASSERT_EQ(p.start[from]->fixed, anyFixed);
+    int expected = -1;
+    for (int v : given)
+      if (p.start[v]->fixed == anyFixed && (expected < 0 || v == rep)) expected = v;
+    if (p.start[rep] && p.start[rep]->fixed == anyFixed) expected = rep;
+    ASSERT_EQ(from, expected);
+    for (int v : members) {
+      ASSERT_EQ(r.startFrom[v], from);
+      ASSERT_EQ(r.start[v]->value, r.sign[v] * *asRep(from) + 0.0);
+      if (p.start[v] && *asRep(v) != *asRep(from)) ++reported;
+    }
+  }
+  size_t conflicts = std::count_if(r.conflicts.begin(), r.conflicts.end(), [](const AliasConflict& c) {
+    return c.kind == AliasConflict::StartValues || c.kind == AliasConflict::FixedStartValues;
+  });
+  ASSERT_EQ(conflicts, reported);
+}
+
 TEST(AliasElimination, RandomProblemsAgreeWithTheBfsOracle) {
   std::mt19937 rng(20261124);
   for (int round = 0; round < 400; ++round) {
@@ -221,6 +263,9 @@ TEST(AliasElimination, RandomProblemsAgreeWithTheBfsOracle) {
       else p.relations.push_back(AliasRelation::equal(a, static_cast<int>(rng() % n), rng() % 2 ? 1 : -1));
     }
     for (int v = 0; v < n; ++v) p.priority.push_back(static_cast<int>(rng() % 3));
+    for (int v = 0; v < n; ++v)
+      p.start.push_back(rng() % 3 ? std::nullopt
+                                  : std::optional<StartValue>(StartValue{static_cast<double>(rng() % 3) - 1, rng() % 2 == 0}));
     AliasResult r = eliminateAliases(p);
     Oracle oracle{p, {}, {}};
     for (int i = 0; i < m; ++i) {
@@ -241,6 +286,7 @@ TEST(AliasElimination, RandomProblemsAgreeWithTheBfsOracle) {
         ASSERT_EQ(*r.constant[v], c->first);
       }
     }
+    expectStartsChosenByTheRule(p, r);
   }
 }
 
