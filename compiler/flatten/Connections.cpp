@@ -328,17 +328,22 @@ void Flattener::eliminateAliases(const std::vector<std::vector<ConnectorEnd>>& s
 // every member but the representative becomes ±it (or the value); the representative takes the
 // class's start value. A component's own variable made another stays a result column.
 void Flattener::applyAliases(const structural::AliasResult& r, const ValueKeys& keys) {
+  int n = static_cast<int>(r.representative.size());
+  std::vector<int> size(n, 0), classOf(n, -1);  // by representative
+  for (int v = 0; v < n; ++v) ++size[r.representative[v]];
   std::vector<std::vector<int>> classes;
-  std::unordered_map<int, size_t> classOf;  // representative → its class
-  for (int v = 0; v < static_cast<int>(r.representative.size()); ++v) {
-    auto [it, inserted] = classOf.try_emplace(r.representative[v], classes.size());
-    if (inserted) classes.emplace_back();
-    classes[it->second].push_back(v);
+  for (int v = 0; v < n; ++v) {
+    int rep = r.representative[v];
+    if (size[rep] == 1 && !r.constant[rep]) continue;
+    if (classOf[rep] < 0) {
+      classOf[rep] = static_cast<int>(classes.size());
+      classes.emplace_back();
+    }
+    classes[classOf[rep]].push_back(v);
   }
   for (const std::vector<int>& members : classes) {
     int rep = r.representative[members.front()];
     bool known = r.constant[rep].has_value();
-    if (members.size() == 1 && !known) continue;
     SourceRange where = out_.variables[members.front()].declRange;
     if (!known && r.startFrom[rep] >= 0 && r.startFrom[rep] != rep) {
       out_.variables[rep].start = keys.expr(r.start[rep]->value);
