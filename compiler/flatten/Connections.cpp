@@ -403,20 +403,23 @@ void Flattener::reportRejectedAlias(const AliasEquation& a, const Equation& e, c
 void Flattener::reportUnusedStart(const structural::AliasConflict& c, const structural::AliasResult& r) {
   int var = c.variables.front();
   const Variable& v = out_.variables[var];
+  auto plain = [&](int u) { return out_.variables[u].role == VarRole::Unknown && !connectorPotential_[u]; };
   std::string with;
+  bool byEquations = plain(var);  // a plain unknown is joined by alias equations (or to a potential)
   if (c.variables.size() == 1) {
     with = sym::toString(ctx_, v.alias);
   } else {
     int rep = r.representative[var];
     int named = var == rep ? c.variables[1] : rep;
     bool negated = var != rep && r.sign[var] < 0;
+    byEquations = byEquations && plain(named);
     with = std::string(negated ? "the negative of " : "") + "'" + std::string(out_.variables[named].name) +
            "', which starts at " + sym::toString(ctx_, out_.variables[named].start);
   }
   const Instance* owner = varOwner_[var];
   diags_.warning(owner && owner->decl ? owner->decl->nameRange : v.declRange, DiagCode::W0302,
-                 "the start value " + sym::toString(ctx_, v.start) + " of '" + std::string(v.name) +
-                     "' is not used: through connections it is " + with,
+                 "the start value " + sym::toString(ctx_, v.start) + " of '" + std::string(v.name) + "' is not used: " +
+                     (byEquations ? "through alias equations" : "through connections") + " it is " + with,
                  "give the start value to one of the joined variables only");
 }
 

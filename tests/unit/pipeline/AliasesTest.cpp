@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "CompiledModel.h"
+#include "dae/Dae.h"
 #include "driver/Backends.h"
 #include "output/ResultSink.h"
 #include "sim/RunOptions.h"
@@ -77,6 +78,14 @@ TEST(AliasEquations, PlainAliasesLeaveTheDaeAndKeepTheirColumns) {
   for (const char* name : {"w", "g", "h"})
     EXPECT_NE(std::find(outputs.begin(), outputs.end(), name), outputs.end()) << name << " is not a result column";
   EXPECT_TRUE(m.compilation().diags.diagnostics().empty()) << rendered(m.compilation());  // w's start agrees
+  // What `qdot equations --json` lists: two unknowns, v starting at 1 (w's start -1 through w = -v).
+  std::ostringstream json;
+  dae::printEquationsJson(json, m.dae(), m.compilation().ctx, m.compilation().sources);
+  size_t names = 0;
+  for (size_t at = json.str().find("\"name\""); at != std::string::npos; at = json.str().find("\"name\"", at + 1)) ++names;
+  EXPECT_EQ(names, 4u) << json.str();  // x, v, the parameter c0, the Jacobi integral
+  EXPECT_NE(json.str().find(R"({"name": "v", "kind": "algebraic", "role": "algebraic", "start": "1")"), std::string::npos)
+      << json.str();
 }
 
 TEST(AliasEquations, EliminatedVariablesFollowTheClosedForm) {
@@ -122,6 +131,26 @@ TEST(AliasEquations, EqualAndOppositeIsALocatedError) {
 TEST(AliasEquations, AVariableGivenTwoValuesIsALocatedError) {
   expectOneError("model M\n  parameter Real p = 1;\n  Real a, b;\nequation\n  a = -b;\n  b = p;\n  a = 3;\nend M;",
                  DiagCode::E0321, 7, 3, "'a' is given twice");
+}
+
+TEST(AliasEquations, StartValueThatDisagreesThroughTheSignIsReportedWhereItIsGiven) {
+  driver::Compilation c;
+  ASSERT_TRUE(driver::compileSource(c, "aliases.qd", R"(model M
+  Real x(start = 1, fixed = true);
+  Real a(start = 1), b(start = 1);
+equation
+  der(x) = a;
+  a = x;
+  b = -a;
+end M;)", "", driver::Stage::Dae)) << rendered(c);
+  ASSERT_EQ(c.diags.diagnostics().size(), 1u) << rendered(c);
+  const Diagnostic& d = c.diags.diagnostics().front();
+  EXPECT_EQ(d.code, DiagCode::W0302);
+  LineCol at = c.sources.lineCol(d.range.file, d.range.begin);
+  EXPECT_EQ(at.line, 3u);
+  EXPECT_EQ(at.col, 22u);
+  EXPECT_EQ(d.message,
+            "the start value 1 of 'b' is not used: through alias equations it is the negative of 'a', which starts at 1");
 }
 
 TEST(AliasEquations, StatesAndDerivativesAreNotAliases) {
