@@ -1,12 +1,16 @@
 // Connections (spec §7): connect(a, b) puts connectors in connection sets (union–find); each set's
 // potentials are one variable and its flows sum to zero (an inside connector's flow counts +, an
 // outside one's −; an unconnected inside connector's flow is zero). Potentials equal through
-// connections and alias equations (`a.s = s`, `a.s = s0`) become one variable or one known
-// expression (Variable::alias). A connector's flow is the generalized force on the coordinate its
+// connections and alias equations (`a.s = s`, `a.s = s0`), and plain unknowns made ± one another or
+// given by parameters (`x = -y`, `x = 2*p`), become one variable or one known expression
+// (Variable::alias; the classes are the structural alias pass's). A connector's flow is the generalized force on the coordinate its
 // potential is in its component (itself, if the component's energies use it): the component's
 // Euler–Lagrange expression for that coordinate equals the sum of those flows.
 #include <algorithm>
+#include <cmath>
 #include <numeric>
+#include <optional>
+#include <tuple>
 
 #include "flatten/Flattener.h"
 #include "support/Assert.h"
@@ -41,7 +45,51 @@ struct UnionFind {
 
 bool isUnknownOrCoordinate(const Variable& v) { return v.role == VarRole::Unknown || v.role == VarRole::Coordinate; }
 
+/// `s` or `-s` for a symbol s: (s, ±1).
+std::optional<std::pair<Expr, int>> signedSymbol(Expr e) {
+  if (e->isSymbol()) return std::pair{e, 1};
+  if (e->kind == sym::Kind::Mul && (e->value == 1 || e->value == -1) && e->args.size() == 1 && e->args[0]->isSymbol() &&
+      e->exps[0]->isOne())
+    return std::pair{e->args[0], e->value > 0 ? 1 : -1};
+  return std::nullopt;
+}
+
+/// A residual c*x + d*y with |c| = |d| (`x = y`, `x = -y`, `x + y = 0`): (x, y, sign) with x = sign*y.
+std::optional<std::tuple<Expr, Expr, int>> symbolPair(Expr r) {
+  if (r->kind != sym::Kind::Add || r->value != 0 || r->args.size() != 2 || !r->args[0]->isSymbol() ||
+      !r->args[1]->isSymbol() || std::abs(r->coefs[0]) != std::abs(r->coefs[1]))
+    return std::nullopt;
+  return std::tuple{r->args[0], r->args[1], r->coefs[0] == r->coefs[1] ? -1 : 1};
+}
+
 }  // namespace
+
+/// Known values (start values, what a class of variables is given) as numbers for the alias pass,
+/// which only compares them and negates them: each expression up to its sign gets a key k >= 1,
+/// its negative -k, and zero 0.
+class ValueKeys {
+ public:
+  explicit ValueKeys(sym::Context& ctx) : ctx_(ctx) {}
+  double key(Expr e) {
+    if (e->isZero()) return 0;
+    if (auto it = keys_.find(e); it != keys_.end()) return it->second;
+    exprs_.push_back(e);
+    double k = static_cast<double>(exprs_.size());
+    keys_[e] = k;
+    if (Expr n = ctx_.neg(e); n != e) keys_[n] = -k;
+    return k;
+  }
+  Expr expr(double key) const {
+    if (key == 0) return ctx_.zero();
+    Expr e = exprs_[static_cast<size_t>(std::abs(key)) - 1];
+    return key > 0 ? e : ctx_.neg(e);
+  }
+
+ private:
+  sym::Context& ctx_;
+  std::unordered_map<Expr, double> keys_;
+  std::vector<Expr> exprs_;
+};
 
 void Flattener::lowerConnect(const ast::Equation& eq) {
   Instance& a = instanceOf(*eq.lhs);
@@ -58,24 +106,15 @@ void Flattener::lowerConnect(const ast::Equation& eq) {
   connections_.push_back({ea, eb, eq.range});
 }
 
-// An equation between two variables, or between a connector potential and an expression of
-// parameters and time, may define an alias; the connections decide (connectAll).
+// An equation between two variables may let a potential stand for a coordinate (aliasPairs,
+// coordinateOfPotential). One that looks like an alias (`x = ±y`, `x + y = 0`, `x = known`) is a
+// candidate: whether it is one is decided once every variable is known (eliminateAliases).
 void Flattener::recordAlias(size_t index) {
   const Equation& e = out_.equations[index];
   int x = out_.variableOf(e.lhs), y = out_.variableOf(e.rhs);
-  if (x >= 0 && y >= 0 && isUnknownOrCoordinate(out_.variables[x]) && isUnknownOrCoordinate(out_.variables[y])) {
+  if (x >= 0 && y >= 0 && isUnknownOrCoordinate(out_.variables[x]) && isUnknownOrCoordinate(out_.variables[y]))
     cur_->aliasPairs.push_back({x, y});
-    if (connectorPotential_[x] || connectorPotential_[y]) aliasCandidates_.push_back(index);
-    return;
-  }
-  int p = x >= 0 && connectorPotential_[x] ? x : y >= 0 && connectorPotential_[y] ? y : -1;
-  if (p < 0 || out_.variables[p].role != VarRole::Unknown) return;
-  Expr other = p == x ? e.rhs : e.lhs;
-  for (Expr s : ctx_.freeSymbols(other)) {
-    int v = out_.variableOf(s);
-    if (v < 0 || (out_.variables[v].role != VarRole::Parameter && out_.variables[v].role != VarRole::Time)) return;
-  }
-  aliasCandidates_.push_back(index);
+  if (signedSymbol(e.lhs) || signedSymbol(e.rhs) || symbolPair(e.residual)) aliasCandidates_.push_back(index);
 }
 
 void Flattener::connectAll() {
@@ -167,12 +206,67 @@ void Flattener::eliminateFlow(int var, Expr value, SourceRange where) {
   out_.outputs.push_back({std::string(out_.variables[var].name), out_.variables[var].symbol, out_.variables[var].declRange});
 }
 
-// Potentials equal through a connection set or an alias equation are one variable: a declared
-// coordinate if there is one, else a coordinate a component's energy made, else the first; or, if
-// one of them is given by parameters and time (`a.s = s0`), that expression.
+// Which equations are aliases (spec §7 and the plain ones):
+//  * two variables, unknowns or coordinates, one of them a connector's potential: `a.s = s`;
+//  * a connector's potential given by parameters and time: `a.s = s0`, a prescribed motion;
+//  * `x = ±y` (also `x + y = 0`) between two plain unknowns: not a connector's potential, not a
+//    state (no der(x)), not already an alias (a flow its connection set gives);
+//  * `±x = value` for a plain unknown x and a value of parameters only.
+// Anything else stays an equation: a coordinate's or a state's dynamics is never an alias.
+std::optional<AliasEquation> Flattener::aliasEquation(const Equation& e) {
+  int x = out_.variableOf(e.lhs), y = out_.variableOf(e.rhs);
+  if (x >= 0 && y >= 0 && isUnknownOrCoordinate(out_.variables[x]) && isUnknownOrCoordinate(out_.variables[y]) &&
+      (connectorPotential_[x] || connectorPotential_[y]))
+    return AliasEquation{x, y, 1, nullptr, true};
+  int p = x >= 0 && connectorPotential_[x] ? x : y >= 0 && connectorPotential_[y] ? y : -1;
+  if (p >= 0) {
+    if (out_.variables[p].role != VarRole::Unknown || !overParameters(p == x ? e.rhs : e.lhs, true)) return std::nullopt;
+    return AliasEquation{p, -1, 1, p == x ? e.rhs : e.lhs, true};
+  }
+  if (auto pair = symbolPair(e.residual)) {
+    auto [a, b, sign] = *pair;
+    int va = out_.variableOf(a), vb = out_.variableOf(b);
+    if (plainUnknown(va) && plainUnknown(vb)) return AliasEquation{va, vb, sign, nullptr, false};
+  }
+  for (bool left : {true, false}) {
+    auto s = signedSymbol(left ? e.lhs : e.rhs);
+    Expr other = left ? e.rhs : e.lhs;
+    if (!s || !plainUnknown(out_.variableOf(s->first)) || !overParameters(other, false)) continue;
+    return AliasEquation{out_.variableOf(s->first), -1, 1, s->second > 0 ? other : ctx_.neg(other), false};
+  }
+  return std::nullopt;
+}
+
+bool Flattener::plainUnknown(int var) const {
+  if (var < 0) return false;
+  const Variable& v = out_.variables[var];
+  return v.role == VarRole::Unknown && !connectorPotential_[var] && v.derivative < 0 && !v.alias;
+}
+
+bool Flattener::overParameters(Expr e, bool timeToo) {
+  for (Expr s : ctx_.freeSymbols(e)) {
+    int v = out_.variableOf(s);
+    if (v < 0 || (out_.variables[v].role != VarRole::Parameter && !(timeToo && out_.variables[v].role == VarRole::Time)))
+      return false;
+  }
+  return true;
+}
+
+// Variables equal (or opposite) through connection sets and alias equations are one variable: a
+// declared coordinate if there is one, else a coordinate a component's energy made, else the
+// first; or, if the class is given a known value (`a.s = s0`), that expression. The classes are
+// the structural alias pass's (structural/AliasElimination.h): variables are its ids, known values
+// its constants (ValueKeys). An equation it rejects is reported (E0321) and stays an equation.
 void Flattener::eliminateAliases(const std::vector<std::vector<ConnectorEnd>>& sets, const std::vector<SourceRange>& ranges) {
-  UnionFind uf;
-  uf.grow(out_.variables.size());
+  using structural::AliasRelation;
+  structural::AliasProblem problem;
+  problem.numVariables = static_cast<int>(out_.variables.size());
+  std::vector<char> touched(out_.variables.size(), 0);
+  auto relate = [&](AliasRelation r) {
+    touched[r.a] = 1;
+    if (r.b >= 0) touched[r.b] = 1;
+    problem.relations.push_back(r);
+  };
   std::unordered_map<int, SourceRange> connectedAt;  // a connected potential → its set's connect
   for (size_t s = 0; s < sets.size(); ++s) {
     const sema::CheckedClass& cls = *sets[s].front().connector->cls;
@@ -182,81 +276,84 @@ void Flattener::eliminateAliases(const std::vector<std::vector<ConnectorEnd>>& s
       for (const ConnectorEnd& e : sets[s]) values.push_back(valueOf(*e.connector, *e.connector->cls->find(d->name), ranges[s]));
       for (size_t k = 1; k < values.size(); ++k)
         for (size_t j = 0; j < values[k].size(); ++j) {
-          uf.unite(out_.variableOf(values[0].elems[j]), out_.variableOf(values[k].elems[j]));
+          relate(AliasRelation::equal(out_.variableOf(values[0].elems[j]), out_.variableOf(values[k].elems[j])));
           connectedAt[out_.variableOf(values[k].elems[j])] = ranges[s];
           connectedAt[out_.variableOf(values[0].elems[j])] = ranges[s];
         }
     }
   }
-  std::unordered_map<int, std::pair<Expr, SourceRange>> bound;  // set root → its known value
-  std::vector<char> removed(out_.equations.size(), 0);
+  ValueKeys keys(ctx_);
+  size_t firstEquation = problem.relations.size();
+  std::vector<std::pair<size_t, AliasEquation>> aliasEquations;  // (equation index, what it says)
   for (size_t index : aliasCandidates_) {
-    const Equation& e = out_.equations[index];
-    int x = out_.variableOf(e.lhs), y = out_.variableOf(e.rhs);
-    bool twoVariables = x >= 0 && y >= 0 && isUnknownOrCoordinate(out_.variables[x]) && isUnknownOrCoordinate(out_.variables[y]);
-    int p = twoVariables ? x : (x >= 0 && connectorPotential_[x]) ? x : y;
-    int root = uf.find(p);
-    auto known = bound.find(root);
-    if (twoVariables) {
-      int other = uf.find(y);
-      auto otherKnown = bound.find(other);
-      if (root == other || (known != bound.end() && otherKnown != bound.end())) {
-        auto& diag = diags_.error(e.origin.range, DiagCode::E0321,
-                                  "'" + std::string(out_.variables[x].name) + "' and '" + std::string(out_.variables[y].name) +
-                                      "' are already " + (root == other ? "equal" : "both given") + " through connections",
-                                  "remove this equation, or one of the connections");
-        if (known != bound.end()) diag.notes.push_back({known->second.second, "given here"});
-        continue;
-      }
-      std::pair<Expr, SourceRange> value;
-      bool hasValue = known != bound.end() || otherKnown != bound.end();
-      if (hasValue) value = known != bound.end() ? known->second : otherKnown->second;
-      bound.erase(root), bound.erase(other);
-      uf.unite(root, other);
-      if (hasValue) bound[uf.find(root)] = value;
-    } else {
-      if (known != bound.end()) {  // reported at the connection, where the user joined the two
-        auto at = connectedAt.find(p);
-        auto& diag = diags_.error(at != connectedAt.end() ? at->second : e.origin.range, DiagCode::E0321,
-                                  "'" + std::string(out_.variables[p].name) + "' is given twice (connected to another fixed potential)",
-                                  "remove one of the two, or the connection between them");
-        diag.notes.push_back({e.origin.range, "given here"});
-        diag.notes.push_back({known->second.second, "and here"});
-        continue;
-      }
-      bound[root] = {p == x ? e.rhs : e.lhs, e.origin.range};
-    }
-    removed[index] = 1;
+    std::optional<AliasEquation> a = aliasEquation(out_.equations[index]);
+    if (!a) continue;
+    relate(a->y >= 0 ? AliasRelation::equal(a->x, a->y, a->sign) : AliasRelation::fixedTo(a->x, keys.key(a->value)));
+    aliasEquations.push_back({index, *a});
   }
-  // Representatives: members in creation order.
-  std::unordered_map<int, std::vector<int>> members;
-  size_t count = uf.parent.size();
-  for (size_t v = 0; v < count; ++v)
-    if (uf.find(static_cast<int>(v)) != static_cast<int>(v) || bound.count(static_cast<int>(v)))
-      members[uf.find(static_cast<int>(v))];
-  for (size_t v = 0; v < count; ++v)
-    if (auto it = members.find(uf.find(static_cast<int>(v))); it != members.end()) it->second.push_back(static_cast<int>(v));
-  std::vector<int> roots;
-  for (const auto& [r, list] : members) roots.push_back(r);
-  std::sort(roots.begin(), roots.end());
-  for (int r : roots) {
-    const std::vector<int>& list = members[r];
-    SourceRange where = out_.variables[list.front()].declRange;
-    auto known = bound.find(r);
-    auto declared = [&](int v) { return out_.variables[v].role == VarRole::Coordinate && !connectorPotential_[v]; };
-    auto coordinate = [&](int v) { return out_.variables[v].role == VarRole::Coordinate; };
-    int rep = -1;
-    if (known == bound.end()) {
-      auto it = std::find_if(list.begin(), list.end(), declared);
-      if (it == list.end()) it = std::find_if(list.begin(), list.end(), coordinate);
-      rep = it == list.end() ? list.front() : *it;
+  problem.priority.resize(out_.variables.size());
+  problem.start.resize(out_.variables.size());
+  for (size_t v = 0; v < out_.variables.size(); ++v) {
+    if (!touched[v]) continue;
+    const Variable& var = out_.variables[v];
+    problem.priority[v] = var.role != VarRole::Coordinate ? 0 : connectorPotential_[v] ? 1 : 2;
+    if (var.start) problem.start[v] = structural::StartValue{keys.key(var.start), var.fixed};
+  }
+  structural::AliasResult result = structural::eliminateAliases(problem);
+
+  std::vector<char> removed(out_.equations.size(), 0);
+  for (size_t k = 0; k < aliasEquations.size(); ++k) {
+    const auto& [index, a] = aliasEquations[k];
+    const structural::RelationOutcome& o = result.outcome[firstEquation + k];
+    if (o.kind == structural::RelationOutcome::Joined) {
+      removed[index] = 1;
+      continue;
     }
-    for (int v : list) {
-      if (v == rep) continue;
-      Expr value = known != bound.end() ? known->second.first : out_.variables[rep].symbol;
-      keepStart(v, rep, value);
-      setAlias(v, value, where);
-      // A component's own variable made equal to another stays a result column.
+    // Only alias equations give a class its value: an earlier relation is one of them.
+    SourceRange earlier = o.earlier >= 0 ? out_.equations[aliasEquations[o.earlier - firstEquation].first].origin.range
+                                         : SourceRange{};
+    reportRejectedAlias(a, out_.equations[index], o, earlier, connectedAt);
+  }
+  applyAliases(result, keys);
+  for (const structural::AliasConflict& c : result.conflicts)
+    if (c.kind == structural::AliasConflict::StartValues || c.kind == structural::AliasConflict::FixedStartValues)
+      reportUnusedStart(c, result);
+  size_t kept = 0;
+  for (size_t i = 0; i < out_.equations.size(); ++i)
+    if (i >= removed.size() || !removed[i]) out_.equations[kept++] = std::move(out_.equations[i]);
+  out_.equations.resize(kept);
+}
+
+// Each class of more than one variable, or with a known value, in the order of its first member:
+// every member but the representative becomes ±it (or the value); the representative takes the
+// class's start value. A component's own variable made another stays a result column.
+void Flattener::applyAliases(const structural::AliasResult& r, const ValueKeys& keys) {
+  int n = static_cast<int>(r.representative.size());
+  std::vector<int> size(n, 0), classOf(n, -1);  // by representative
+  for (int v = 0; v < n; ++v) ++size[r.representative[v]];
+  std::vector<std::vector<int>> classes;
+  for (int v = 0; v < n; ++v) {
+    int rep = r.representative[v];
+    if (size[rep] == 1 && !r.constant[rep]) continue;
+    if (classOf[rep] < 0) {
+      classOf[rep] = static_cast<int>(classes.size());
+      classes.emplace_back();
+    }
+    classes[classOf[rep]].push_back(v);
+  }
+  for (const std::vector<int>& members : classes) {
+    int rep = r.representative[members.front()];
+    bool known = r.constant[rep].has_value();
+    SourceRange where = out_.variables[members.front()].declRange;
+    if (!known && r.startFrom[rep] >= 0 && r.startFrom[rep] != rep) {
+      out_.variables[rep].start = keys.expr(r.start[rep]->value);
+      out_.variables[rep].fixed = out_.variables[rep].fixed || r.start[rep]->fixed;
+      out_.variables[rep].fixedGiven = out_.variables[rep].fixedGiven || out_.variables[r.startFrom[rep]].fixedGiven;
+    }
+    for (int v : members) {
+      if (v == rep && !known) continue;
+      Expr repSymbol = out_.variables[rep].symbol;
+      setAlias(v, known ? keys.expr(*r.constant[v]) : r.sign[v] > 0 ? repSymbol : ctx_.neg(repSymbol), where);
       if (!connectorPotential_[v]) {
         out_.outputs.push_back({std::string(out_.variables[v].name), out_.variables[v].symbol, out_.variables[v].declRange});
         if (int d = out_.variables[v].derivative; d >= 0)
@@ -264,31 +361,66 @@ void Flattener::eliminateAliases(const std::vector<std::vector<ConnectorEnd>>& s
       }
     }
   }
-  size_t kept = 0;
-  for (size_t i = 0; i < out_.equations.size(); ++i)
-    if (i >= removed.size() || !removed[i]) out_.equations[kept++] = std::move(out_.equations[i]);
-  out_.equations.resize(kept);
 }
 
-// A start value given to a variable that becomes another: moved to the representative if that has
-// none (Mass m2(s(start = 0.2)) joined rigidly to m1), else a warning when the two differ.
-void Flattener::keepStart(int var, int rep, Expr value) {
-  Variable& v = out_.variables[var];
-  if (!v.start) return;
-  Expr other = rep >= 0 ? out_.variables[rep].start : value;
-  if (rep >= 0 && !other) {
-    out_.variables[rep].start = v.start;
-    out_.variables[rep].fixed = v.fixed || out_.variables[rep].fixed;
-    out_.variables[rep].fixedGiven = v.fixedGiven || out_.variables[rep].fixedGiven;
+// An alias equation that repeats or contradicts what the connections and the earlier alias
+// equations say.
+void Flattener::reportRejectedAlias(const AliasEquation& a, const Equation& e, const structural::RelationOutcome& o,
+                                    SourceRange earlier, const std::unordered_map<int, SourceRange>& connectedAt) {
+  using Kind = structural::RelationOutcome::Kind;
+  auto quoted = [&](int v) { return std::string("'").append(out_.variables[v].name).append("'"); };
+  std::string x = quoted(a.x);
+  std::string through = a.ofPotential ? "through connections" : "through other equations";
+  if (o.kind == Kind::SignCycle) {
+    std::string y = quoted(a.y);
+    diags_.error(e.origin.range, DiagCode::E0321,
+                 x + " and " + y + " are made both equal and opposite " + through + ", which forces both to 0",
+                 "remove this equation or the one it contradicts; write " + std::string(out_.variables[a.x].name) +
+                     " = 0 if that is meant");
     return;
   }
-  if (other == v.start) return;
-  std::string with = rep >= 0 ? "'" + std::string(out_.variables[rep].name) + "', which starts at " + sym::toString(ctx_, other)
-                              : sym::toString(ctx_, value);
+  if (a.y >= 0) {
+    bool given = o.earlier >= 0;
+    auto& diag = diags_.error(e.origin.range, DiagCode::E0321,
+                              x + " and " + quoted(a.y) + " are already " +
+                                  (given ? "both given" : a.sign > 0 ? "equal" : "opposite") + " " + through,
+                              a.ofPotential ? "remove this equation, or one of the connections" : "remove this equation");
+    if (given) diag.notes.push_back({earlier, "given here"});
+    return;
+  }
+  // Reported at the connection, where the user joined the two.
+  auto at = a.ofPotential ? connectedAt.find(a.x) : connectedAt.end();
+  auto& diag = diags_.error(at != connectedAt.end() ? at->second : e.origin.range, DiagCode::E0321,
+                            x + " is given twice " +
+                                (a.ofPotential ? std::string("(connected to another fixed potential)") : through),
+                            a.ofPotential ? "remove one of the two, or the connection between them"
+                                          : "remove one of the two equations");
+  if (a.ofPotential) diag.notes.push_back({e.origin.range, "given here"});
+  diag.notes.push_back({earlier, a.ofPotential ? "and here" : "given here"});
+}
+
+// A start value given to a variable that becomes another, when its class starts elsewhere (Mass
+// m2(s(start = 0.2)) joined rigidly to m1 with its own).
+void Flattener::reportUnusedStart(const structural::AliasConflict& c, const structural::AliasResult& r) {
+  int var = c.variables.front();
+  const Variable& v = out_.variables[var];
+  auto plain = [&](int u) { return out_.variables[u].role == VarRole::Unknown && !connectorPotential_[u]; };
+  std::string with;
+  bool byEquations = plain(var);  // a plain unknown is joined by alias equations (or to a potential)
+  if (c.variables.size() == 1) {
+    with = sym::toString(ctx_, v.alias);
+  } else {
+    int rep = r.representative[var];
+    int named = var == rep ? c.variables[1] : rep;
+    bool negated = var != rep && r.sign[var] < 0;
+    byEquations = byEquations && plain(named);
+    with = std::string(negated ? "the negative of " : "") + "'" + std::string(out_.variables[named].name) +
+           "', which starts at " + sym::toString(ctx_, out_.variables[named].start);
+  }
   const Instance* owner = varOwner_[var];
   diags_.warning(owner && owner->decl ? owner->decl->nameRange : v.declRange, DiagCode::W0302,
-                 "the start value " + sym::toString(ctx_, v.start) + " of '" + std::string(v.name) +
-                     "' is not used: through connections it is " + with,
+                 "the start value " + sym::toString(ctx_, v.start) + " of '" + std::string(v.name) + "' is not used: " +
+                     (byEquations ? "through alias equations" : "through connections") + " it is " + with,
                  "give the start value to one of the joined variables only");
 }
 

@@ -6,6 +6,7 @@
 #include <functional>
 #include <initializer_list>
 #include <map>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
@@ -13,6 +14,7 @@
 #include <vector>
 
 #include "flatten/Flatten.h"
+#include "structural/AliasElimination.h"
 
 namespace qdot::flat {
 
@@ -149,6 +151,16 @@ struct Connection {
   SourceRange range;
 };
 
+class ValueKeys;  // Connections.cpp
+
+/// An equation that makes variable x another variable (x = sign * y) or a known value (y < 0:
+/// x = value, an expression of parameters, and of time for a connector potential).
+struct AliasEquation {
+  int x = -1, y = -1, sign = 1;
+  sym::Expr value = nullptr;
+  bool ofPotential = false;  ///< a connector's potential's (spec §7), not between plain unknowns
+};
+
 class Flattener {
  public:
   Flattener(const sema::CheckedModel& m, sym::Context& ctx, DiagnosticEngine& diags, FlattenLimits limits,
@@ -188,7 +200,7 @@ class Flattener {
   std::vector<Instance*> varOwner_;       ///< by variable: the instance that declared it
   std::vector<char> connectorPotential_;  ///< by variable: a potential of a connector
   std::vector<Connection> connections_;
-  std::vector<size_t> aliasCandidates_;   ///< equations `potential = variable or known expression`
+  std::vector<size_t> aliasCandidates_;   ///< equations that may be aliases (`x = ±y`, `x = known`)
   std::vector<std::pair<std::string, sym::Expr>> iterators_;  ///< innermost last
   std::vector<std::pair<const Value*, int>> endContext_;      ///< (array, dimension) being subscripted, for `end`
 
@@ -228,8 +240,14 @@ class Flattener {
   void connectAll();
   void addFlowBalances(const std::vector<std::vector<ConnectorEnd>>& sets, const std::vector<SourceRange>& ranges);
   void eliminateAliases(const std::vector<std::vector<ConnectorEnd>>& sets, const std::vector<SourceRange>& ranges);
+  std::optional<AliasEquation> aliasEquation(const Equation& e);
+  bool plainUnknown(int var) const;
+  bool overParameters(sym::Expr e, bool timeToo);
+  void applyAliases(const structural::AliasResult& r, const ValueKeys& keys);
+  void reportRejectedAlias(const AliasEquation& a, const Equation& e, const structural::RelationOutcome& outcome,
+                           SourceRange earlier, const std::unordered_map<int, SourceRange>& connectedAt);
+  void reportUnusedStart(const structural::AliasConflict& c, const structural::AliasResult& r);
   void setAlias(int var, sym::Expr value, SourceRange where);
-  void keepStart(int var, int rep, sym::Expr value);
   void eliminateFlow(int var, sym::Expr value, SourceRange where);
   void attachFlows();
   int coordinateOfPotential(const Instance& inst, int x);
