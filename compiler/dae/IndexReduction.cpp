@@ -4,6 +4,8 @@
 // differentiated along the chains (d/dt x = der(x), d/dt time = 1) with sym::DirectionalDerivative.
 #include "dae/IndexReduction.h"
 
+#include <algorithm>
+
 #include "dae/Balance.h"
 #include "structural/Matching.h"
 
@@ -32,7 +34,7 @@ class Reducer {
         const Variable& v = dae_.variables[chain[j]];
         if (j + 1 < chain.size()) derivative_.setRate(v.y, dae_.variables[chain[j + 1]].y);
         else if (v.kind == VarKind::State) derivative_.setRate(v.y, v.yp);
-        else unrated_.push_back(v.y);
+        else unrated_.resize(std::max<size_t>(unrated_.size(), v.y->symbolId + 1)), unrated_[v.y->symbolId] = 1;
       }
     for (size_t k = 0; k < cs.equations.size(); ++k)
       if (plan.differentiations[k] > 0) differentiate(cs.equations[k], plan.differentiations[k]);
@@ -40,8 +42,8 @@ class Reducer {
 
   /// de/dt, or null if e contains an algebraic unknown whose derivative is not in the system.
   Expr timeDerivative(Expr e) {
-    for (Expr s : unrated_)
-      if (ctx_.dependsOn(e, s)) return nullptr;
+    for (Expr s : ctx_.freeSymbols(e))
+      if (s->symbolId < unrated_.size() && unrated_[s->symbolId]) return nullptr;
     return derivative_(e);
   }
 
@@ -100,7 +102,7 @@ class Reducer {
   sym::Context& ctx_;
   sym::DirectionalDerivative derivative_;
   std::vector<std::vector<int>> chains_;
-  std::vector<Expr> unrated_;  ///< algebraic chain tops
+  std::vector<char> unrated_;  ///< by symbol id: an algebraic chain top (no rate)
 };
 
 // g and dg/dt of every constraint as invariants, to watch their drift.

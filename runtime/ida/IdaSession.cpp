@@ -13,6 +13,8 @@
 #include <sunmatrix/sunmatrix_dense.h>
 #include <sunmatrix/sunmatrix_sparse.h>
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <cmath>
 
@@ -121,6 +123,7 @@ struct IdaSession::Impl {
   void calculateConsistentValues(double tout1);
   void estimateAlgebraicRates(double tout1);
   void checkStartMatrix();
+  std::vector<std::string> dependentColumns(const std::vector<double>& at0, const std::vector<double>& at1) const;
   bool chooseDummyDerivatives(double time, N_Vector yv, N_Vector ypv, bool best);
   void solveInitialConditions();
   int initialNewtonIterations = -1;  ///< -1: no initialization system was solved
@@ -448,6 +451,29 @@ void IdaSession::Impl::estimateAlgebraicRates(double tout1) {
 // differential unknown and every algebraic unknown (the columns of ∂F/∂y' and ∂F/∂y that IDA's
 // matrix needs). A column that is zero there — a mass or moment of inertia of 0 (`-p m=0`) leaves
 // its coordinate's acceleration in no equation — is named here, instead of a Newton failure later.
+// After index reduction a column can be non-zero and still dependent: with m = 0 the rows of a
+// pendulum's x and y both contain only the multiplier. The matrix of the unknowns IDA solves for
+// (y' of a differential unknown, y of an algebraic one) must be regular; QR with column pivoting
+// names the columns beyond its numerical rank. Small systems only (dense).
+std::vector<std::string> IdaSession::Impl::dependentColumns(const std::vector<double>& at0,
+                                                            const std::vector<double>& at1) const {
+  constexpr uint32_t kLargest = 400;
+  if (n > kLargest) return {};
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, n);
+  for (uint32_t c = 0; c < n; ++c)
+    for (int32_t k = model.jacobianColumnStarts[c]; k < model.jacobianColumnStarts[c + 1]; ++k)
+      A(model.jacobianRowIndices[k], c) = model.isDifferential[c] ? at1[k] - at0[k] : at0[k];
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
+  qr.setThreshold(1e-12);
+  std::vector<std::string> dependent;
+  auto names = nameList(model.variableNames, n);
+  for (Eigen::Index k = qr.rank(); k < static_cast<Eigen::Index>(n); ++k) {
+    auto c = static_cast<uint32_t>(qr.colsPermutation().indices()[k]);
+    dependent.push_back(model.isDifferential[c] ? "der(" + std::string(names[c]) + ")" : std::string(names[c]));
+  }
+  return dependent;
+}
+
 void IdaSession::Impl::checkStartMatrix() {
   uint32_t nnz = model.jacobianNonzeros;
   std::vector<double> at0(nnz), at1(nnz);
@@ -462,13 +488,18 @@ void IdaSession::Impl::checkStartMatrix() {
       zero &= (model.isDifferential[c] ? at1[k] - at0[k] : at0[k]) == 0;
     if (zero) missing.push_back(model.isDifferential[c] ? "der(" + std::string(names[c]) + ")" : std::string(names[c]));
   }
+  bool dependent = missing.empty() && dummies;
+  if (dependent) missing = dependentColumns(at0, at1);
   if (missing.empty()) return;
   std::string list;
   for (size_t i = 0; i < missing.size() && i < 8; ++i) list += (i ? ", " : "") + missing[i];
   if (missing.size() > 8) list += fmt::format(", … ({} more)", missing.size() - 8);
-  throw IdaError(fmt::format("the equations do not determine {} at t = {:.10g}: no equation contains {} there (a "
-                             "mass or moment of inertia of 0 makes the mass matrix singular; check the parameters)",
-                             list, options.t0, missing.size() == 1 ? "it" : "them"),
+  std::string why = dependent ? "the equations are singular in " + std::string(missing.size() == 1 ? "it" : "them") +
+                                     " there (dependent on the other unknowns)"
+                              : "no equation contains " + std::string(missing.size() == 1 ? "it" : "them") + " there";
+  throw IdaError(fmt::format("the equations do not determine {} at t = {:.10g}: {} (a mass or moment of inertia of 0 "
+                             "makes the mass matrix singular; check the parameters)",
+                             list, options.t0, why),
                  options.t0);
 }
 

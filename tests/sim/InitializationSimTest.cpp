@@ -47,5 +47,15 @@ TEST(Initialization, NonlinearConditionFromTheStartGuess) {
   expectColumn(r, "x", [](double t) { return 2 * std::cos(t); }, 2);
 }
 
+// Issue 10 acceptance: a singular mass matrix is reported as such, naming the unknowns, before IDA
+// runs — also after index reduction, where m = 0 leaves no column empty but makes two rows parallel.
+TEST(Initialization, SingularMassMatrixOfAConstrainedModelIsNamed) {
+  auto r = runQdot("examples/constrained/cartesian_pendulum.qd", {"-p", "m=0", "--stop", "1"});
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_NE(r.log.find("at t = 0: the equations do not determine der(der("), std::string::npos) << r.log;
+  EXPECT_NE(r.log.find("mass matrix singular"), std::string::npos) << r.log;
+  EXPECT_EQ(r.log.find("IDACalcIC"), std::string::npos) << r.log;
+}
+
 }  // namespace
 }  // namespace qdot::simtest
