@@ -56,7 +56,7 @@ class Builder {
     for (const auto& v : dae_.variables) {
       d.variableNames.push_back(v.name);
       d.isDifferential.push_back(v.kind == dae::VarKind::State);
-      d.fixed.push_back(defaultFixed(v));
+      d.fixed.push_back(!defaultFixed(v) ? kStartGuess : v.declaration.fixedGiven ? kFixedAsWritten : kFixedByDefault);
     }
     for (const auto& p : dae_.parameters) {
       d.parameterNames.push_back(p.name);
@@ -77,7 +77,7 @@ class Builder {
   // Coordinates and velocities that are states start fixed; another state is fixed if it has a
   // start value (or fixed = true); an algebraic variable's start is only a guess unless fixed.
   static bool defaultFixed(const dae::Variable& v) {
-    if (v.declaration.fixed) return true;
+    if (v.declaration.fixedGiven || v.declaration.fixed) return v.declaration.fixed;  // as written
     if (v.kind != dae::VarKind::State) return false;
     return v.role == dae::UnknownRole::Coordinate || v.role == dae::UnknownRole::Velocity ||
            v.declaration.start != nullptr;
@@ -237,7 +237,7 @@ class Builder {
         if (v.y != target) continue;  // a derivative's value is a condition of the initialization system
         if (!acceptInitialEquation(e, i, j, true)) return true;  // reported
         uint32_t src = addSource("initial equation " + std::to_string(i + 1), e.origin.range, equationText(e));
-        starts[j].y0 = value, starts[j].source = src, m_.description.fixed[j] = 1;
+        starts[j].y0 = value, starts[j].source = src, m_.description.fixed[j] = kFixedAsWritten;
         startUse_[j] = dae::StartUse::Required;
         return true;
       }
@@ -302,7 +302,8 @@ class Builder {
     }
     std::optional<std::vector<char>> kept = dae::planInitialization(dae_, initialRows_, startUse_, ctx_, diags_);
     if (!kept) return;
-    for (size_t j = 0; j < kept->size(); ++j) m_.description.fixed[j] = (*kept)[j];
+    for (size_t j = 0; j < kept->size(); ++j)
+      if (!(*kept)[j]) m_.description.fixed[j] = kStartGuess;
   }
 
   // out = [y0 (n), yp0 (n), nominal (n)]; stores of a plain 0 serve no source.

@@ -22,6 +22,7 @@
 #include "ida/IdaFlags.h"
 #include "ida/InitialSystem.h"
 #include "ida/ModelCheck.h"
+#include "qdot/model_description.hpp"
 
 namespace qdot::rt {
 
@@ -381,19 +382,43 @@ bool IdaSession::Impl::startIsConsistent() {
   return std::all_of(F.begin(), F.end(), [](double f) { return std::abs(f) <= kConsistentResidual; });
 }
 
+// Consistent initialization changes only algebraic unknowns. One whose start was fixed — by default
+// (a coordinate the constraints made dependent) or as written — is checked: as written and changed
+// it contradicts the other conditions (an error naming it); as written and kept it was redundant (a
+// note); by default and changed it was a guess (a note saying so); a fixed algebraic variable of a
+// model without constraints that had to change is a warning, as before.
 void IdaSession::Impl::noteChangedFixedStarts(const std::vector<double>& before) {
   if (!model.fixedStarts) return;
   std::vector<int32_t> fixed(n, 0);
   if (model.fixedStarts(&model, fixed.data()) != 0) return;
   auto names = nameList(model.variableNames, n);
+  std::vector<std::string> redundant;
   for (uint32_t i = 0; i < n; ++i) {
     double now = data(y)[i];
     bool changed = std::abs(now - before[i]) > 1e-6 * std::max(1.0, std::abs(before[i]));
-    if (model.isDifferential[i] || !fixed[i] || !changed) continue;
-    warnings.push_back(
-        fmt::format("the fixed start value of algebraic {} ({:.10g}) was changed to {:.10g} to make "
-                    "the initial values consistent",
-                    names[i], before[i], now));
+    if (model.isDifferential[i] || !fixed[i]) continue;
+    if (dummies && fixed[i] == kFixedAsWritten && changed)
+      throw IdaError(fmt::format("the initial conditions contradict each other: the start value of {} is fixed "
+                                 "at {:.10g}, but the constraints and the other start values give {:.10g} (declare it "
+                                 "a guess, {}(start = ..., fixed = false), or correct it)",
+                                 names[i], before[i], now, names[i]),
+                     options.t0);
+    if (dummies && fixed[i] == kFixedAsWritten) redundant.emplace_back(names[i]);
+    else if (dummies && changed)
+      warnings.push_back(fmt::format("note: the start value of {} ({:.10g}) was a guess: the constraints give {:.10g}",
+                                     names[i], before[i], now));
+    else if (changed)
+      warnings.push_back(
+          fmt::format("the fixed start value of algebraic {} ({:.10g}) was changed to {:.10g} to make "
+                      "the initial values consistent",
+                      names[i], before[i], now));
+  }
+  if (!redundant.empty()) {
+    std::string list;
+    for (const auto& r : redundant) list += (list.empty() ? "" : ", ") + r;
+    warnings.push_back(fmt::format("note: the fixed start value{} of {} {} redundant with the constraints (and "
+                                   "consistent with them)",
+                                   redundant.size() == 1 ? "" : "s", list, redundant.size() == 1 ? "is" : "are"));
   }
 }
 

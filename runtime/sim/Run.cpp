@@ -13,8 +13,8 @@ namespace qdot::rt {
 namespace {
 
 void report(const SimulationResult& result, bool stats, std::ostream& log) {
-  for (const std::string& warning : result.warnings)
-    log << "warning: " << warning << '\n';
+  for (const std::string& warning : result.warnings)  // a line that is a note says so itself
+    log << (warning.rfind("note: ", 0) == 0 ? "" : "warning: ") << warning << '\n';
   if (!result.success)
     log << fmt::format("error: the simulation failed at t = {:.10g}: {}\n", result.failureTime, result.message);
   if (!result.success && result.rows > 0)

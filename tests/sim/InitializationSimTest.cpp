@@ -47,6 +47,22 @@ TEST(Initialization, NonlinearConditionFromTheStartGuess) {
   expectColumn(r, "x", [](double t) { return 2 * std::cos(t); }, 2);
 }
 
+// Over-determined but consistent (all start positions of a constrained model fixed): accepted with a
+// note naming the redundant start; inconsistent: an error naming it. The pendulum then swings as usual
+// (energy g·y + v²/2 kept to the tolerance).
+TEST(Initialization, RedundantConsistentStartsAreANoteInconsistentAnError) {
+  auto ok = runQdot("tests/sim/models/init_redundant_pendulum.qd", {"--stop", "1", "--rtol", "1e-8"});
+  ASSERT_EQ(ok.exitCode, 0) << ok.log;
+  EXPECT_NE(ok.log.find("redundant with the constraints"), std::string::npos) << ok.log;
+  const auto &y = ok.col("y"), &vx = ok.col("der(x)"), &vy = ok.col("der(y)");
+  for (size_t i = 0; i < y.size(); ++i)
+    ASSERT_NEAR(9.81 * y[i] + 0.5 * (vx[i] * vx[i] + vy[i] * vy[i]), 9.81 * -0.8, 1e-5) << "row " << i;
+  auto bad = runQdot("tests/sim/models/init_redundant_pendulum.qd", {"--stop", "1", "-p", "y0=-0.7"});
+  EXPECT_NE(bad.exitCode, 0);
+  EXPECT_NE(bad.log.find("the initial conditions contradict each other: the start value of"), std::string::npos)
+      << bad.log;
+}
+
 // Issue 10 acceptance: a singular mass matrix is reported as such, naming the unknowns, before IDA
 // runs — also after index reduction, where m = 0 leaves no column empty but makes two rows parallel.
 TEST(Initialization, SingularMassMatrixOfAConstrainedModelIsNamed) {

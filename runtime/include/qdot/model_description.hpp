@@ -12,6 +12,10 @@
 
 namespace qdot {
 
+/// Values of ModelDescription::fixed: a guess, fixed by default (a state's start), fixed as written
+/// (`fixed = true`, or set by an initial equation). Any non-zero value is fixed.
+inline constexpr int32_t kStartGuess = 0, kFixedByDefault = 1, kFixedAsWritten = 2;
+
 struct ModelDescription {
   std::string name;
   std::vector<std::string> variableNames;          ///< [nVariables], in result order
@@ -19,7 +23,7 @@ struct ModelDescription {
   std::vector<std::string> parameterDescriptions;  ///< [nParameters], "" if none
   std::vector<std::string> outputNames, invariantNames;
   std::vector<int32_t> isDifferential;  ///< [nVariables]: 1 if y' of the variable appears
-  std::vector<int32_t> fixed;           ///< [nVariables]: start value fixed during initialisation
+  std::vector<int32_t> fixed;           ///< [nVariables]: start value fixed during initialisation (kFixed…)
   std::vector<int32_t> jacobianColumnStarts, jacobianRowIndices;  ///< CSC, column j = variable j
   /// The Integer parameters, as "n = 8": they size the model, so they are fixed in what was
   /// compiled (an executable's --help shows them; qdot build -p n=3 changes them).

@@ -149,7 +149,7 @@ TEST(Kernel, ExplicitInitialEquationsSetStartsOthersBecomeRows) {
   std::vector<double> p = {3.0, 1.5}, out(6);
   kernel::interpret(m.program(ModelProgram::InitialValues), {.p = p.data()}, out);
   EXPECT_EQ(out, (std::vector<double>{1.5, 3.0, 0, 0, 0, 0}));
-  EXPECT_EQ(m.description.fixed, (std::vector<int32_t>{0, 1}));  // x is computed from der(der(x)) = 5
+  EXPECT_EQ(m.description.fixed, (std::vector<int32_t>{kStartGuess, kFixedAsWritten}));  // x from der(der(x)) = 5
   EXPECT_EQ(m.description.initialRows, (std::vector<int32_t>{2}));
   EXPECT_EQ(m.description.residualCount(), 3u);
 }
