@@ -290,16 +290,10 @@ class Builder {
   }
 
   // Initial equations that are not start values are rows of F used only at t0 (the run's initial
-  // Newton solve); the starts they replace are computed instead of kept.
+  // Newton solve); the starts they replace are computed instead of kept. After index reduction the
+  // plan sees every row (the constraint and its derivatives); the run solves with the rows of the
+  // dummy derivatives chosen at the start values.
   void planInitialRows() {
-    if (!dae_.differentiatedRows.empty()) {
-      for (const auto& e : initialRows_)
-        diags_.error(e.origin.range.valid() ? e.origin.range : dae_.range, DiagCode::E0601,
-                     "in a model with constraints an initial equation must read v = expression over parameters",
-                     "give the start values of the coordinates and velocities instead (those the constraints make "
-                     "dependent are computed)");
-      return;
-    }
     std::optional<std::vector<char>> kept = dae::planInitialization(dae_, initialRows_, startUse_, ctx_, diags_);
     if (!kept) return;
     for (size_t j = 0; j < kept->size(); ++j)

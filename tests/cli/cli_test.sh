@@ -93,7 +93,7 @@ contains check-summary "model UTube is valid: 3 equations in 3 unknowns (2 state
   "$qdot" check "$src/examples/textbook/utube.qd"
 [ -z "$("$qdot" check --quiet "$src/examples/textbook/utube.qd" 2>&1)" ] && pass=$((pass + 1)) || {
   echo "FAIL check-quiet: printed something"; fail=$((fail + 1)); }
-check check-kernel-errors 1 "$qdot" check "$src/tests/diagnostics/implicit_initial_equation.qd"
+check check-kernel-errors 1 "$qdot" check "$src/tests/diagnostics/initial_conflicts.qd"
 # A model read from standard input (-): the same output as from the file.
 check stdin-check 0 sh -c "'$qdot' check - < '$src/examples/textbook/utube.qd'"
 if [ "$("$qdot" run - --stop 0.5 < "$src/examples/textbook/utube.qd")" = "$("$qdot" run "$src/examples/textbook/utube.qd" --stop 0.5)" ]; then

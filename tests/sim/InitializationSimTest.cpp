@@ -47,6 +47,23 @@ TEST(Initialization, NonlinearConditionFromTheStartGuess) {
   expectColumn(r, "x", [](double t) { return 2 * std::cos(t); }, 2);
 }
 
+// A constrained model with conditions on a velocity and an acceleration: the solution satisfies the
+// constraint and its two derivatives and both conditions at t0, and the energy is kept afterwards.
+TEST(Initialization, ConstrainedModelWithConditionsOnDerivatives) {
+  RunResult r = run("init_constrained", 1);
+  const auto &x = r.col("x"), &y = r.col("y"), &vx = r.col("der(x)"), &vy = r.col("der(y)");
+  const auto &ax = r.col("der(der(x))"), &ay = r.col("der(der(y))");
+  ASSERT_FALSE(x.empty());
+  EXPECT_NEAR(x[0] * x[0] + y[0] * y[0], 1, 1e-10);
+  EXPECT_NEAR(x[0] * vx[0] + y[0] * vy[0], 0, 1e-10);
+  EXPECT_NEAR(x[0] * ax[0] + y[0] * ay[0] + vx[0] * vx[0] + vy[0] * vy[0], 0, 1e-8);
+  EXPECT_NEAR(vx[0], 0.4, 1e-10);
+  EXPECT_NEAR(x[0] * ax[0], -2.8, 1e-8);
+  double e0 = 9.81 * y[0] + 0.5 * (vx[0] * vx[0] + vy[0] * vy[0]);
+  for (size_t i = 0; i < x.size(); ++i)
+    ASSERT_NEAR(9.81 * y[i] + 0.5 * (vx[i] * vx[i] + vy[i] * vy[i]), e0, 1e-5) << "row " << i;
+}
+
 // Over-determined but consistent (all start positions of a constrained model fixed): accepted with a
 // note naming the redundant start; inconsistent: an error naming it. The pendulum then swings as usual
 // (energy g·y + v²/2 kept to the tolerance).
