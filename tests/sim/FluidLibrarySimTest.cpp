@@ -41,8 +41,9 @@ long statistic(const RunResult& r, const std::string& name) {
 // ---------------------------------------------------------------------------------------------
 // torricelli.qd: OpenTank A = 0.5 m², h0 = 1 m → Orifice Cd = 0.5, area a = 1e-2 m² → Ambient.
 //   A dh/dt = −Cd a √(2 g h):  h(t) = (√h0 − k t)²,  k = (Cd a/A) √(g/2),  drain time t_e = √h0/k.
-// Bound while the exact level is above 1 mm (t ≤ 43.7 s of t_e = 45.15 s): 100 rtol h0 for the
-// integration (a smooth decay, no phase error) plus the orifice's regularisation. Its flow is
+// Bound while the exact level is above 1 mm (t ≤ 43.7 s of t_e = 45.15 s): 200 rtol h0 for the
+// integration (a smooth decay, no phase error; IDA's first low-order steps leave an offset of about
+// 100 rtol h0, measured 0.9e-6 m at rtol 1e-8) plus the orifice's regularisation. Its flow is
 // (1 + (δ/Δp)²)^(−1/4) of Torricelli's, δ = dpSmall = 1 Pa, Δp = ρ g h, so √h lags the exact
 // √h by ∫ (δ/(ρ g s²))²/4 ds ≤ (δ/ρg)²/(12 h^(3/2)) and h by (δ/ρg)²/(6 h): 1.7e-6 m at h = 1 mm
 // (we allow 1.5 times that). The tank's throttle acts only below hDry = 0.1 mm: no error here.
@@ -59,7 +60,7 @@ TEST(FluidLibrary, TorricelliDrainsToEmptyAndStays) {
   auto exact = [&](double t) { return std::pow(std::sqrt(h0) - k * t, 2); };
   auto bound = [&](double t) {
     const double reg = std::pow(dpSmall / (rho * g), 2) / (6 * exact(t));
-    return 100 * kRtol * h0 + 1.5 * reg;
+    return 200 * kRtol * h0 + 1.5 * reg;
   };
   const RunResult draining = rowsUntil(r, tCompared);
   compareColumn(draining, "tank.h", exact, bound);
@@ -145,6 +146,64 @@ TEST(FluidLibrary, TwoTanksOscillateAndConserveVolume) {
   EXPECT_LE(volumeDrift, 100 * kRtol * V);
   std::cout << "[measured] ω = " << w << " rad/s, volume drift " << volumeDrift << " m³ (" << volumeDrift / V
             << " of V)\n";
+}
+
+// ---------------------------------------------------------------------------------------------
+// flow_reversal.qd: tank 1 → Pump (dp0 = 2e4 Pa, Q0 = 0.03 m³/s, speed 1/(1 + e^((t − 30)/2))) →
+// Pipe (L = 20 m, D = 10 cm, roughness 0.1 mm) → tank 2, both tanks 1 m² at 1 m. The pump lifts
+// water into tank 2 (turbulent, Re ≈ 2e5), stops around t = 30 s, and the flow reverses and sloshes
+// back and forth, each time through the laminar–turbulent blend and zero flow.
+// Checks: (1) the flow changes sign at least four times; (2) the total volume A1 h1 + A2 h2 is
+// conserved within 100 rtol V; (3) the stored energy E = rho L Q²/(2 Ap) + rho g (A1 h1² + A2 h2²)/2
+// obeys dE/dt = Q (b.p − a.p)_pump − Q Δp_f(Q): once the pump has stopped (t ≥ 60 s, speed² < 1e-13)
+// both terms only remove energy (the stopped pump's −dp0 Q abs(Q)/Q0² and the friction are odd in Q), so
+// E never rises from one output time to the next by more than its error scale rtol rho g (A1 + A2)
+// (1 m)² = 2e-4 J (each level's absolute tolerance rtol·1 m times rho g A h); a stopped pump whose
+// curve were even in Q (−dp0 Q²/Q0²) would drive the backflow, but not enough to show here (the pipe's friction would still win); so the pump is checked on its own: (4) its
+// rise b.p − a.p equals dp0 (speed² − Q abs(Q)/Q0²) at every output time within 100 rtol · 1e5 Pa
+// (the pressures' error scale is their nominal 1 bar), and once stopped it absorbs power,
+// Q (b.p − a.p) ≤ 0 (an even curve would give +22 W at −0.01 m³/s);
+// (5) no chattering at zero flow: at most 1500 steps and 150 error-test failures for the 200 s
+// (854 and 55 measured at rtol 1e-8).
+TEST(FluidLibrary, FlowReversalThroughZeroWithoutChattering) {
+  auto r = runExample("flow_reversal");
+  expectGrid(r, 0, 200, 0.1);
+  const double rho = 1000, g = 9.81, A1 = 1, A2 = 1, L = 20, D = 0.1, Ap = M_PI * D * D / 4;
+  const auto &t = r.time(), &Q = r.col("pipe.Q"), &h1 = r.col("tank1.h"), &h2 = r.col("tank2.h");
+  int signChanges = 0;
+  for (std::size_t i = 1; i < Q.size(); ++i) signChanges += (Q[i - 1] > 0) != (Q[i] > 0);
+  EXPECT_GE(signChanges, 4);
+  EXPECT_GT(*std::max_element(Q.begin(), Q.end()), 0.015);  // pumped forward, turbulent
+  EXPECT_LT(*std::min_element(Q.begin(), Q.end()), -0.01);  // and back, turbulent
+  const double V = A1 * 1 + A2 * 1;
+  EXPECT_LE(drift(r, "volume"), 100 * kRtol * V);
+  auto energy = [&](std::size_t i) {
+    return rho * L * Q[i] * Q[i] / (2 * Ap) + rho * g * (A1 * h1[i] * h1[i] + A2 * h2[i] * h2[i]) / 2;
+  };
+  const double energyTolerance = kRtol * rho * g * (A1 + A2);
+  double largestRise = -INFINITY;
+  for (std::size_t i = 1; i < t.size(); ++i) {
+    if (t[i - 1] < 60) continue;
+    const double rise = energy(i) - energy(i - 1);
+    largestRise = std::max(largestRise, rise);
+    EXPECT_LE(rise, energyTolerance) << "energy rose between t = " << t[i - 1] << " and " << t[i];
+  }
+  EXPECT_LT(energy(t.size() - 1), energy(600) - 1) << "the sloshing is damped";
+  const double dp0 = 2e4, Q0 = 0.03;
+  const auto &pIn = r.col("tank1.port.p"), &pOut = r.col("pump.b.p");
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    const double speed = 1 / (1 + std::exp((t[i] - 30) / 2)), rise = pOut[i] - pIn[i];
+    EXPECT_NEAR(rise, dp0 * (speed * speed - Q[i] * std::fabs(Q[i]) / (Q0 * Q0)), 100 * kRtol * 1e5) << "t = " << t[i];
+    if (t[i] >= 60) {
+      EXPECT_LE(Q[i] * rise, 1e-9) << "the stopped pump drives the flow at t = " << t[i];
+    }
+  }
+  const long steps = statistic(r, "steps"), failures = statistic(r, "error-test failures");
+  EXPECT_LE(steps, 1500);
+  EXPECT_LE(failures, 150);
+  std::cout << "[measured] " << signChanges << " flow reversals, steps " << steps << ", error-test failures "
+            << failures << ", volume drift " << drift(r, "volume") << " m³, largest energy rise after the stop "
+            << largestRise << " J (tolerance " << energyTolerance << " J)\n";
 }
 
 }  // namespace
