@@ -2,6 +2,7 @@
 // by `qdot run` and compared with the fluid chapter's closed forms at every output time; the
 // zero-flow and empty-tank cases also have their solver step counts bounded (no chattering, no
 // step-size collapse).
+#include <algorithm>
 #include <cmath>
 #include <regex>
 
@@ -204,6 +205,78 @@ TEST(FluidLibrary, FlowReversalThroughZeroWithoutChattering) {
   std::cout << "[measured] " << signChanges << " flow reversals, steps " << steps << ", error-test failures "
             << failures << ", volume drift " << drift(r, "volume") << " m³, largest energy rise after the stop "
             << largestRise << " J (tolerance " << energyTolerance << " J)\n";
+}
+
+// ---------------------------------------------------------------------------------------------
+// The Pipe's friction law as stdlib/Fluid/README.md states it: Hagen–Poiseuille up to Re 2000,
+// Darcy–Weisbach with Haaland's factor from 4000, the C¹ smooth step s = x²(3 − 2x) between.
+struct PipeLaw {
+  double L, D, roughness, rho = 1000, mu = 1e-3;
+  double area() const { return M_PI * D * D / 4; }
+  double reynolds(double Q) const { return rho * std::fabs(Q) * D / (mu * area()); }
+  static double haaland(double Re, double relativeRoughness) {
+    return std::pow(-1.8 * std::log10(std::pow(relativeRoughness / 3.7, 1.11) + 6.9 / Re), -2);
+  }
+  double loss(double Q) const {
+    const double laminar = 128 * mu * L * Q / (M_PI * std::pow(D, 4));
+    const double Re = reynolds(Q), f = haaland(std::max(Re, 2000.0), roughness / D);
+    const double turbulent = f * (L / D) * rho / (2 * area() * area()) * Q * std::fabs(Q);
+    const double x = std::clamp((Re - 2000) / 2000, 0.0, 1.0), s = x * x * (3 - 2 * x);
+    return (1 - s) * laminar + s * turbulent;
+  }
+  // The steady flow for a pressure difference dp > 0 (the loss grows with Q: bisection).
+  double steadyFlow(double dp) const {
+    double lo = 0, hi = 1;
+    for (int i = 0; i < 200; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (loss(mid) < dp ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+  }
+};
+
+// Colebrook's Darcy friction factor, by fixed-point iteration (converges in a few steps).
+double colebrook(double Re, double relativeRoughness) {
+  double f = 0.02;
+  for (int i = 0; i < 100; ++i) f = std::pow(-2 * std::log10(relativeRoughness / 3.7 + 2.51 / (Re * std::sqrt(f))), -2);
+  return f;
+}
+
+// steady_pipes.qd: three pipes between reservoirs settle to the flow where rho g ΔH = Δp_f(Q):
+// turbulent (ΔH = 10 m, L = 100 m, D = 5 cm, roughness 0.05 mm; Re ≈ 1.06e5), in the transition band
+// (ΔH = 0.15 m, L = 10 m, D = 1 cm; Re ≈ 3000) and laminar (ΔH = 0.02 m; Re ≈ 610). The steady flows
+// are solved from the law above by bisection; at t = 60 s the model must equal them within
+// 100 rtol (Q + Ap·1 m/s) (the flow's error scale) plus what is left of the slowest (laminar)
+// start-up, Q e^(−60/τ) with τ = rho D²/(32 mu) = 3.125 s (5e-9 relative). The laminar flow also
+// equals Hagen–Poiseuille's rho g ΔH π D⁴/(128 mu L), and Haaland's factor at the turbulent pipe's
+// Reynolds number is within 2 % of Colebrook's (the Moody chart's equation).
+TEST(FluidLibrary, SteadyPipeFlowInAllThreeRegimes) {
+  auto r = runExample("steady_pipes");
+  expectGrid(r, 0, 60, 0.1);
+  const double rho = 1000, g = 9.81, mu = 1e-3;
+  struct Case {
+    const char* pipe;
+    PipeLaw law;
+    double head;
+  } cases[] = {{"turbulent", {100, 0.05, 5e-5}, 10}, {"transition", {10, 0.01, 0}, 0.15}, {"laminar", {10, 0.01, 0}, 0.02}};
+  for (const auto& c : cases) {
+    const double expected = c.law.steadyFlow(rho * g * c.head), got = r.col(std::string(c.pipe) + ".Q").back();
+    const double tau = rho * c.law.D * c.law.D / (32 * mu);
+    EXPECT_NEAR(got, expected, 100 * kRtol * (expected + c.law.area()) + expected * std::exp(-60 / tau)) << c.pipe;
+    std::cout << "[measured] " << c.pipe << ": Q = " << got << " m³/s (law " << expected << ", relative error "
+              << (got - expected) / expected << "), Re = " << c.law.reynolds(got) << "\n";
+  }
+  const double reTurbulent = cases[0].law.reynolds(r.col("turbulent.Q").back());
+  const double reTransition = cases[1].law.reynolds(r.col("transition.Q").back());
+  EXPECT_GT(reTurbulent, 4000);
+  EXPECT_GT(reTransition, 2000);
+  EXPECT_LT(reTransition, 4000);
+  const double D = 0.01, L = 10, poiseuille = rho * g * 0.02 * M_PI * std::pow(D, 4) / (128 * mu * L);
+  EXPECT_NEAR(r.col("laminar.Q").back(), poiseuille, 1e-6 * poiseuille);
+  const double fHaaland = PipeLaw::haaland(reTurbulent, 1e-3), fColebrook = colebrook(reTurbulent, 1e-3);
+  EXPECT_NEAR(fHaaland, fColebrook, 0.02 * fColebrook);
+  std::cout << "[measured] Re " << reTurbulent << ": Haaland f = " << fHaaland << ", Colebrook f = " << fColebrook
+            << " (" << (fHaaland - fColebrook) / fColebrook << ")\n";
 }
 
 }  // namespace
