@@ -279,5 +279,57 @@ TEST(FluidLibrary, SteadyPipeFlowInAllThreeRegimes) {
             << " (" << (fHaaland - fColebrook) / fColebrook << ")\n";
 }
 
+// ---------------------------------------------------------------------------------------------
+// venturi_meter.qd: Reservoir (3 m) → Pipe (20 m, D = 5 cm, smooth) → Venturi (D1 = 5 cm,
+// D2 = 3.5 cm) → Ambient. (1) The meter reads the flow: Q = A2 √(2 (a.p − throat.p)/(rho (1 − (A2/A1)²)))
+// with a.p = 101325 Pa (the meter discharges to the atmosphere, b.p = a.p) equals pipe.Q at every
+// output time with Q > 1e-4 m³/s within 1e-6 relative (throat.p is computed from Q, so only the
+// pressure's rounding, 1e-11 of 1 bar against a difference of ≥ 100 Pa, separates them).
+// (2) Loss-free meter: the steady flow is the pipe law's for the whole head, rho g · 3 m = Δp_f(Q),
+// within 100 rtol (Q + Ap) (the start-up's time constant is about 1.1 s, gone by t = 40 s).
+TEST(FluidLibrary, VenturiMeterReadsTheFlow) {
+  auto r = runExample("venturi_meter");
+  expectGrid(r, 0, 40, 0.05);
+  const double rho = 1000, g = 9.81, A1 = M_PI * 0.05 * 0.05 / 4, A2 = M_PI * 0.035 * 0.035 / 4, pa = 101325;
+  const auto &Q = r.col("pipe.Q"), &throat = r.col("meter.throat.p");
+  double largest = 0;
+  for (std::size_t i = 0; i < Q.size(); ++i) {
+    if (Q[i] <= 1e-4) continue;
+    const double measured = A2 * std::sqrt(2 * (pa - throat[i]) / (rho * (1 - std::pow(A2 / A1, 2))));
+    EXPECT_NEAR(measured, Q[i], 1e-6 * Q[i]) << "t = " << r.time()[i];
+    largest = std::max(largest, std::fabs(measured - Q[i]) / Q[i]);
+  }
+  const PipeLaw pipe{20, 0.05, 0};
+  const double steady = pipe.steadyFlow(rho * g * 3);
+  EXPECT_NEAR(Q.back(), steady, 100 * kRtol * (steady + pipe.area()));
+  EXPECT_GT(throat.back(), 0) << "the throat pressure must stay physical (no cavitation)";
+  std::cout << "[measured] meter reading vs flow: largest relative difference " << largest << "; steady Q "
+            << Q.back() << " (pipe law " << steady << ", Re " << pipe.reynolds(Q.back()) << "), throat "
+            << throat.back() << " Pa\n";
+}
+
+// ---------------------------------------------------------------------------------------------
+// floating_box.qd: FloatingBox m = 500 kg, Aw = 1 m², released at z0 = 5 cm from rest:
+// z = z0 cos ωt, ω = √(rho g Aw/m) = 4.4294 rad/s, under oscillationBound (100 rtol z0 per period);
+// the period from the upward zero crossings of z (linear interpolation between rows 5 ms apart,
+// error below (ω h)² z0/8 / (ω z0) ≈ 1e-4 of an interval) equals 2π/ω within 1e-5 relative.
+TEST(FluidLibrary, FloatingBoxHeaveFrequency) {
+  auto r = runExample("floating_box");
+  expectGrid(r, 0, 10, 0.005);
+  const double rho = 1000, g = 9.81, m = 500, Aw = 1, z0 = 0.05, w = std::sqrt(rho * g * Aw / m), period = 2 * M_PI / w;
+  compareColumn(r, "box.z", [&](double t) { return z0 * std::cos(w * t); },
+                [&](double t) { return oscillationBound(kRtol, z0, period, t); });
+  compareColumn(r, "der(box.z)", [&](double t) { return -z0 * w * std::sin(w * t); },
+                [&](double t) { return oscillationBound(kRtol, z0 * w, period, t); });
+  const auto &t = r.time(), &z = r.col("box.z");
+  std::vector<double> crossings;
+  for (std::size_t i = 0; i + 1 < z.size(); ++i)
+    if (z[i] < 0 && z[i + 1] >= 0) crossings.push_back(t[i] + (t[i + 1] - t[i]) * z[i] / (z[i] - z[i + 1]));
+  ASSERT_GE(crossings.size(), 3u);
+  const double measured = (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
+  EXPECT_NEAR(measured, period, 1e-5 * period);
+  std::cout << "[measured] heave period " << measured << " s (2π/ω = " << period << " s)\n";
+}
+
 }  // namespace
 }  // namespace qdot::simtest
