@@ -331,5 +331,49 @@ TEST(FluidLibrary, FloatingBoxHeaveFrequency) {
   std::cout << "[measured] heave period " << measured << " s (2π/ω = " << period << " s)\n";
 }
 
+// ---------------------------------------------------------------------------------------------
+// surge_tank.qd: Reservoir H = 10 m → loss-free Pipe (L = 500 m, D = 0.5 m) → surge tank
+// (As = 5 m²) and a valve (Cd = 0.6, a = 0.05 m²) to the atmosphere, in steady flow
+// Q0 = Cd a √(2 g H); the valve closes at t = 10 s (logistic opening, width 5 ms). After it:
+//   hs = H + Q0/(As ω) sin ω(t − 10),  Q = Q0 cos ω(t − 10),  ω = √(g Ap/(L As)),
+// period 2π√(L As/(g Ap)), maximum surge v0 √(L As/(g Ap)) (Ap/As) = Q0/(As ω).
+// Compared from t = 10.5 s (100 widths after the middle of the closure). The smooth closure is the
+// sudden one convolved with a symmetric kernel of width s = 5 ms: it changes the surge's amplitude by
+// the factor πωs/sinh(πωs) = 1 − 3e-8 and its phase not at all. Bounds: oscillationBound with the
+// level's error scale, its largest value H + Q0/(As ω) (the tank's tolerance is relative to its
+// level), and with Q0 for the flow. Before the closure the level stays at H within 100 rtol H.
+// The measured maximum surge equals Q0/(As ω) within 1e-5 relative (rows 0.5 s apart near a peak
+// of period 226 s: (ω·0.25 s)²/2 = 2.4e-5 at worst, the parabola through three rows is exact to
+// far below that).
+TEST(FluidLibrary, SurgeTankPeriodAndMaximumSurge) {
+  auto r = runExample("surge_tank");
+  expectGrid(r, 0, 600, 0.5);
+  const double g = 9.81, H = 10, L = 500, D = 0.5, Ap = M_PI * D * D / 4, As = 5, tc = 10;
+  const double Q0 = 0.6 * 0.05 * std::sqrt(2 * g * H), w = std::sqrt(g * Ap / (L * As)), period = 2 * M_PI / w;
+  const double surge = Q0 / (As * w), v0 = Q0 / Ap;
+  EXPECT_NEAR(surge, v0 * std::sqrt(L * As / (g * Ap)) * (Ap / As), 1e-12);
+  EXPECT_NEAR(period, 2 * M_PI * std::sqrt(L * As / (g * Ap)), 1e-9);
+  const RunResult before = rowsUntil(r, tc - 0.5);
+  compareColumn(before, "surge.h", [&](double) { return H; }, [&](double) { return 100 * kRtol * H; });
+  RunResult after = r;
+  const auto& t = r.time();
+  const std::size_t first = std::lower_bound(t.begin(), t.end(), tc + 0.5) - t.begin();
+  for (auto& [name, column] : after.columns) column.erase(column.begin(), column.begin() + first);
+  after.rows -= first;
+  compareColumn(after, "surge.h", [&](double s) { return H + surge * std::sin(w * (s - tc)); },
+                [&](double s) { return oscillationBound(kRtol, H + surge, period, s - tc); });
+  compareColumn(after, "pipe.Q", [&](double s) { return Q0 * std::cos(w * (s - tc)); },
+                [&](double s) { return oscillationBound(kRtol, Q0, period, s - tc); });
+  const auto& h = r.col("surge.h");
+  const std::size_t peak = std::max_element(h.begin(), h.end()) - h.begin();
+  ASSERT_GT(peak, 0u);
+  ASSERT_LT(peak + 1, h.size());
+  const double curvature = h[peak + 1] - 2 * h[peak] + h[peak - 1], slope = h[peak + 1] - h[peak - 1];
+  const double highest = h[peak] - slope * slope / (8 * curvature);
+  EXPECT_NEAR(highest - H, surge, 1e-5 * surge);
+  std::cout << "[measured] maximum surge " << highest - H << " m (closed form " << surge << " m), period " << period
+            << " s\n";
+}
+
 }  // namespace
 }  // namespace qdot::simtest
