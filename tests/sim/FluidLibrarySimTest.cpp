@@ -375,5 +375,40 @@ TEST(FluidLibrary, SurgeTankPeriodAndMaximumSurge) {
             << " s\n";
 }
 
+// surge_tank_friction.qd: the same with a rough pipe (roughness 0.1 mm), started in steady flow by
+// the initialization system. (1) The start: the level hs0 where rho g (H − hs0) = Δp_f(Q0) with the
+// valve's Q0 = Cd a √(2 g hs0) (its regularisation is 1e-11 relative at 70 kPa), solved by bisection
+// with the pipe law; the model's start equals it within 1e-6 relative (the Newton iteration's
+// tolerance is far below). (2) Damping: the successive maxima of hs − H decrease, the first stays
+// below the loss-free surge Q0/(As ω) for the same Q0, and the last swing (t ≥ 450 s) is less than
+// half the first.
+TEST(FluidLibrary, SurgeTankWithFrictionIsDamped) {
+  auto r = runExample("surge_tank_friction");
+  expectGrid(r, 0, 600, 0.5);
+  const double g = 9.81, H = 10, L = 500, D = 0.5, Ap = M_PI * D * D / 4, As = 5, Cd = 0.6, a = 0.05;
+  const PipeLaw pipe{L, D, 1e-4};
+  double lo = 0, hi = H;  // the start level: the friction head falls as the level (and the flow) falls
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi), Q = Cd * a * std::sqrt(2 * g * mid);
+    (1000 * g * (H - mid) > pipe.loss(Q) ? lo : hi) = mid;
+  }
+  const double hs0 = 0.5 * (lo + hi), Q0 = Cd * a * std::sqrt(2 * g * hs0);
+  EXPECT_NEAR(r.col("surge.h").front(), hs0, 1e-6 * hs0);
+  EXPECT_NEAR(r.col("pipe.Q").front(), Q0, 1e-6 * Q0);
+  const auto &t = r.time(), &h = r.col("surge.h");
+  std::vector<double> maxima;
+  for (std::size_t i = 1; i + 1 < h.size(); ++i)
+    if (t[i] > 10 && h[i] > h[i - 1] && h[i] >= h[i + 1]) maxima.push_back(h[i] - H);
+  ASSERT_GE(maxima.size(), 2u);
+  for (std::size_t i = 1; i < maxima.size(); ++i) EXPECT_LT(maxima[i], maxima[i - 1]) << "swing " << i;
+  const double w = std::sqrt(g * Ap / (L * As));
+  EXPECT_LT(maxima.front(), Q0 / (As * w));
+  EXPECT_LT(maxima.back(), 0.5 * maxima.front());
+  std::cout << "[measured] start level " << h.front() << " m (law " << hs0 << "), Q0 " << r.col("pipe.Q").front()
+            << " m³/s; surge maxima above H:";
+  for (double m : maxima) std::cout << " " << m;
+  std::cout << " m (loss-free " << Q0 / (As * w) << " m)\n";
+}
+
 }  // namespace
 }  // namespace qdot::simtest
