@@ -410,5 +410,36 @@ TEST(FluidLibrary, SurgeTankWithFrictionIsDamped) {
   std::cout << " m (loss-free " << Q0 / (As * w) << " m)\n";
 }
 
+// ---------------------------------------------------------------------------------------------
+// utube_parts.qd against examples/textbook/utube.qd (example 5-2): the U-tube from Fluid parts
+// (two legs A = 1e-4 m², a loss-free pipe l = 1 m) and the textbook's Lagrangian l ẍ + 2 g x = 0 are
+// one system: leg1.h − 0.3 m equals the textbook's x at every output time, both runs at rtol 1e-8,
+// within twice oscillationBound (each run's own error) plus the parts' start offset, and both equal
+// (h/2) cos(√(2g/l) t). The start offset: the ports' flows are algebraic unknowns whose automatic
+// absolute tolerance is rtol × 1e-3 × the largest algebraic magnitude (the pressures, 1 bar), so
+// IDACalcIC leaves them consistent only to about 1e-9 m³/s (measured −9.8e-10 where 0 is exact),
+// which is 1e-5 m/s of level rate in a leg of 1e-4 m²; the first steps carry that into the levels:
+// 2e-6 m measured at t = 0.01 s. We allow 1000 rtol h̄0 = 3.5e-6 m for it (a Fluid model with tiny
+// areas may want `port(Q(nominal = …))` on its tanks).
+TEST(FluidLibrary, UTubeFromPartsEqualsTheTextbookLagrangian) {
+  auto parts = runExample("utube_parts");
+  auto textbook = runQdot("examples/textbook/utube.qd", {"--rtol", num(kRtol)});
+  ASSERT_EQ(textbook.exitCode, 0) << textbook.log;
+  ASSERT_EQ(parts.rows, textbook.rows);
+  const double g = 9.81, l = 1, amp = 0.05, w = std::sqrt(2 * g / l), period = 2 * M_PI / w;
+  const auto &x = textbook.col("x"), &h1 = parts.col("leg1.h"), &t = parts.time();
+  const double startOffset = 1000 * kRtol * 0.35;
+  double largest = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    EXPECT_NEAR(h1[i] - 0.3, x[i], 2 * oscillationBound(kRtol, amp, period, t[i]) + startOffset) << "t = " << t[i];
+    largest = std::max(largest, std::fabs(h1[i] - 0.3 - x[i]));
+  }
+  compareColumn(textbook, "x", [&](double s) { return amp * std::cos(w * s); },
+                [&](double s) { return oscillationBound(kRtol, amp, period, s); });
+  compareColumn(parts, "leg1.h", [&](double s) { return 0.3 + amp * std::cos(w * s); },
+                [&](double s) { return oscillationBound(kRtol, amp, period, s) + startOffset; });
+  std::cout << "[measured] largest |parts − textbook| " << largest << " m\n";
+}
+
 }  // namespace
 }  // namespace qdot::simtest
