@@ -75,6 +75,18 @@ head -1 "$work/two_dof.csv" | grep -q '^time,m1.s,m2.s,' && sed -n 2p "$work/two
 [ -s "$work/two_dof.csv" ] && cmp -s "$work/two_dof.csv" "$work/two_dof-build.csv" && ok \
   || bad "two_dof: the installed qdot's CSV differs from the build tree's"
 
+# The Fluid package comes with the install too: Torricelli's tank (import Fluid.*;) from another
+# directory gives the build tree's CSV.
+cp "$src/examples/fluids/torricelli.qd" "$work/elsewhere/torricelli.qd"
+"$build/qdot" run "$work/elsewhere/torricelli.qd" --stop 10 >"$work/torricelli-build.csv" 2>"$work/run.log" \
+  || { bad "build-tree qdot run torricelli.qd failed"; sed 's/^/    /' "$work/run.log"; }
+if (cd / && without_build_tree "$prefix/bin/qdot" run "$work/elsewhere/torricelli.qd" --stop 10) \
+     >"$work/torricelli.csv" 2>"$work/run.log"; then ok; else
+  bad "installed qdot run of a model with 'import Fluid.*;' failed"; sed 's/^/    /' "$work/run.log"
+fi
+[ -s "$work/torricelli.csv" ] && cmp -s "$work/torricelli.csv" "$work/torricelli-build.csv" && ok \
+  || bad "torricelli: the installed qdot's CSV differs from the build tree's"
+
 # A user library on QDOT_PATH, as a folder (MyLib/package.qd, itself importing Vibration) and as a
 # file (Extra.qd). MyLib.Oscillator is m = 1 on k = 4 from 0.1: s(t) = 0.1 cos 2t; Extra.Free
 # has no force: y stays 1.
