@@ -73,6 +73,12 @@ DummyDerivativeModel::DummyDerivativeModel(const QdotModel& full) : full_(full) 
     links_.push_back({l[0], l[1], l[2]});
     linkOfDerivative_[l[2]] = static_cast<int>(k);
   }
+  // The chain tops: derivatives that have no derivative themselves (computed once: choose() runs
+  // after every step).
+  std::vector<char> hasDerivative(full.nVariables, 0);
+  for (const Link& l : links_) hasDerivative[l.variable] = 1;
+  for (int v = 0; v < static_cast<int>(full.nVariables); ++v)
+    if (linkOfDerivative_[v] >= 0 && !hasDerivative[v]) chainTops_.push_back(v);
   for (uint32_t e = 0; e < full.nDifferentiatedEquations; ++e) {
     rowsOfEquation_.emplace_back(full.differentiatedRows + full.differentiatedRowStarts[e],
                                  full.differentiatedRows + full.differentiatedRowStarts[e + 1]);
@@ -121,13 +127,7 @@ double conditionQuality(const Eigen::MatrixXd& H, const Eigen::MatrixXd& HS) {
 
 std::vector<int> DummyDerivativeModel::candidatesBelow(const std::vector<int>* chosenAbove) const {
   std::vector<int> candidates;
-  if (!chosenAbove) {  // level 1: the chain tops, derivatives of which nothing is the derivative
-    for (int v = 0; v < static_cast<int>(full_.nVariables); ++v)
-      if (linkOfDerivative_[v] >= 0 &&
-          std::none_of(links_.begin(), links_.end(), [&](const Link& l) { return l.variable == v; }))
-        candidates.push_back(v);
-    return candidates;
-  }
+  if (!chosenAbove) return chainTops_;  // level 1
   for (int d : *chosenAbove) {  // one order lower, where that is itself a derivative
     int below = links_[linkOfDerivative_[d]].variable;
     if (linkOfDerivative_[below] >= 0) candidates.push_back(below);

@@ -77,6 +77,7 @@ class DummyDerivativeModel {
   SquareTable table_;
   std::vector<Link> links_;
   std::vector<int> linkOfDerivative_;             // per variable: the link whose derivative it is, or -1
+  std::vector<int> chainTops_;                    // level 1's candidates
   std::vector<std::vector<int>> rowsOfEquation_;  // per differentiated equation: e, e', …
   int levels_ = 0;
 

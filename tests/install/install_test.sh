@@ -62,30 +62,28 @@ grep -q '^0,0.1,0' "$work/exe-llvm.csv" && ok || bad "exe: first row is not x = 
 # --- libraries: the installed standard library, QDOT_PATH, and the error when a package is missing
 # The standard library comes with the install: a model built from Vibration parts runs without
 # flags and gives the same CSV as the build tree's qdot (which reads the library from the sources).
-cp "$src/examples/vibration/two_dof.qd" "$work/elsewhere/two_dof.qd"
-"$build/qdot" run "$work/elsewhere/two_dof.qd" --stop 0.5 >"$work/two_dof-build.csv" 2>"$work/run.log" \
-  || { bad "build-tree qdot run two_dof.qd failed"; sed 's/^/    /' "$work/run.log"; }
-if (cd / && without_build_tree "$prefix/bin/qdot" run "$work/elsewhere/two_dof.qd" --stop 0.5) \
-     >"$work/two_dof.csv" 2>"$work/run.log"; then ok; else
-  bad "installed qdot run of a model with 'import Vibration.*;' failed"; sed 's/^/    /' "$work/run.log"
-fi
+# Runs examples/DIR/NAME.qd, copied elsewhere, with the build tree's and with the installed qdot
+# (from /, build tree hidden) for STOP seconds; the installed run's CSV must be the build tree's.
+runs_like_build_tree() {
+  local dir=$1 name=$2 stop=$3 package=$4
+  cp "$src/examples/$dir/$name.qd" "$work/elsewhere/$name.qd"
+  "$build/qdot" run "$work/elsewhere/$name.qd" --stop "$stop" >"$work/$name-build.csv" 2>"$work/run.log" \
+    || { bad "build-tree qdot run $name.qd failed"; sed 's/^/    /' "$work/run.log"; }
+  if (cd / && without_build_tree "$prefix/bin/qdot" run "$work/elsewhere/$name.qd" --stop "$stop") \
+       >"$work/$name.csv" 2>"$work/run.log"; then ok; else
+    bad "installed qdot run of a model with 'import $package.*;' failed"; sed 's/^/    /' "$work/run.log"
+  fi
+  [ -s "$work/$name.csv" ] && cmp -s "$work/$name.csv" "$work/$name-build.csv" && ok \
+    || bad "$name: the installed qdot's CSV differs from the build tree's"
+}
+runs_like_build_tree vibration two_dof 0.5 Vibration
 # released from rest at m1.s = 0.05, m2.s = 0 (the example's start values)
 head -1 "$work/two_dof.csv" | grep -q '^time,m1.s,m2.s,' && sed -n 2p "$work/two_dof.csv" | grep -q '^0,0.05,0,' \
   && ok || bad "two_dof: not the columns m1.s, m2.s or not the start 0.05, 0"
-[ -s "$work/two_dof.csv" ] && cmp -s "$work/two_dof.csv" "$work/two_dof-build.csv" && ok \
-  || bad "two_dof: the installed qdot's CSV differs from the build tree's"
 
 # The Fluid package comes with the install too: Torricelli's tank (import Fluid.*;) from another
 # directory gives the build tree's CSV.
-cp "$src/examples/fluids/torricelli.qd" "$work/elsewhere/torricelli.qd"
-"$build/qdot" run "$work/elsewhere/torricelli.qd" --stop 10 >"$work/torricelli-build.csv" 2>"$work/run.log" \
-  || { bad "build-tree qdot run torricelli.qd failed"; sed 's/^/    /' "$work/run.log"; }
-if (cd / && without_build_tree "$prefix/bin/qdot" run "$work/elsewhere/torricelli.qd" --stop 10) \
-     >"$work/torricelli.csv" 2>"$work/run.log"; then ok; else
-  bad "installed qdot run of a model with 'import Fluid.*;' failed"; sed 's/^/    /' "$work/run.log"
-fi
-[ -s "$work/torricelli.csv" ] && cmp -s "$work/torricelli.csv" "$work/torricelli-build.csv" && ok \
-  || bad "torricelli: the installed qdot's CSV differs from the build tree's"
+runs_like_build_tree fluids torricelli 10 Fluid
 
 # A user library on QDOT_PATH, as a folder (MyLib/package.qd, itself importing Vibration) and as a
 # file (Extra.qd). MyLib.Oscillator is m = 1 on k = 4 from 0.1: s(t) = 0.1 cos 2t; Extra.Free
