@@ -567,7 +567,7 @@ void IdaSession::Impl::solveInitialConditions() {
                            data(y), data(yp));
     initialNewtonIterations = r.iterations;
   } catch (const std::runtime_error& e) {
-    throw IdaError(fmt::format("at t = {:.10g}: {}", options.t0, e.what()), options.t0);
+    throw IdaError(e.what(), options.t0);  // the run names the time
   }
   check(IDAReInit(ida, options.t0, y, yp), "IDAReInit");
 }
@@ -581,7 +581,7 @@ bool IdaSession::Impl::chooseDummyDerivatives(double time, N_Vector yv, N_Vector
       for (uint32_t i = 0; i < n; ++i) data(id)[i] = model.isDifferential[i] ? 1.0 : 0.0;
     return changed;
   } catch (const std::runtime_error& e) {
-    throw IdaError(fmt::format("at t = {:.10g}: {}", time, e.what()), time);
+    throw IdaError(e.what(), time);  // the run names the time
   }
 }
 
