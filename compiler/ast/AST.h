@@ -272,14 +272,16 @@ struct Equation {
 // The mechanics section (spec §5)
 // ---------------------------------------------------------------------------------------------
 
-enum class MechanicsKind { Kinetic, Potential, Dissipation, Force, Constraint, For };
+enum class MechanicsKind { Kinetic, Potential, Dissipation, Force, Constraint, For, Gravity, Torque };
 
 struct MechanicsStmt {
   MechanicsKind kind;
   SourceRange range;
   SourceRange keywordRange;
-  ExprPtr target;  ///< Force: the coordinate (NameExpr or IndexExpr) inside `force(...)`
-  ExprPtr value;   ///< Kinetic/Potential/Dissipation/Force: the rhs; Constraint: lhs
+  ExprPtr target;  ///< Force/Torque: the coordinate or body (NameExpr or IndexExpr) inside `force(...)`
+  ExprPtr value;   ///< Kinetic/Potential/Dissipation/Force/Gravity/Torque: the rhs; Constraint: lhs
+  ExprPtr at;      ///< Force on a body: `force(b, at = {…})`, the point in body axes (null: the centre of mass)
+  bool world = false;  ///< Torque: `torque(b, world) = …` (world axes; else body axes)
   ExprPtr rhs;     ///< Constraint: rhs
   std::vector<Iterator> iterators;  ///< For
   std::vector<MechanicsStmt> body;  ///< For

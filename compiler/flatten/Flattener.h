@@ -176,6 +176,8 @@ class Flattener {
   std::vector<sym::Expr> iterationValues(const ast::Expr& range);
   sym::Expr timeDerivative(sym::Expr e, SourceRange where);
   sym::Expr rateOf(sym::Expr symbol);
+  Value eulerZXZ(const ast::CallExpr& e);
+  OutputKind outputKind(const ast::Declaration& d);
 
   [[noreturn]] void fail(SourceRange r, DiagCode code, std::string msg, std::string help = {});
 

@@ -20,6 +20,7 @@ const BuiltinFunction kBuiltins[] = {
     {"sign", 1, 1},     {"min", 1, 2},       {"max", 1, 2},   {"der", 1, 1},    {"sum", 1, 1},
     {"product", 1, 1},  {"fill", 2, -1},     {"zeros", 1, -1}, {"ones", 1, -1}, {"cross", 2, 2},
     {"dot", 2, 2},      {"transpose", 1, 1}, {"diagonal", 1, 1}, {"identity", 1, 1}, {"size", 1, 2},
+    {"eulerZXZ", 3, 3},
 };
 
 // Names that parse as calls but belong to events, which qdot does not compile.

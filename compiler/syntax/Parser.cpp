@@ -40,7 +40,8 @@ bool isClassKeyword(TokenKind k) {
 }
 
 bool isMechanicsWord(const Token& t) {
-  return t.isWord("kinetic") || t.isWord("potential") || t.isWord("dissipation") || t.isWord("force");
+  return t.isWord("kinetic") || t.isWord("potential") || t.isWord("dissipation") || t.isWord("force") ||
+         t.isWord("torque") || t.isWord("gravity");
 }
 
 }  // namespace

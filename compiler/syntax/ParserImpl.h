@@ -151,6 +151,7 @@ class Parser {
   std::optional<ast::MechanicsStmt> parseMechanicsStmt();
   ast::MechanicsStmt parseEnergyStmt(ast::MechanicsKind kind);
   ast::MechanicsStmt parseForceStmt();
+  void parseForceQualifier(ast::MechanicsStmt& s, bool torque);
   ast::MechanicsStmt parseConstraintStmt();
   ast::MechanicsStmt parseMechanicsFor();
   std::vector<ast::Iterator> parseForIndices();

@@ -14,6 +14,7 @@
 #include <set>
 
 #include "ida/ModelCheck.h"
+#include "output/AngleUnwrap.h"
 #include "sim/Names.h"
 
 namespace qdot::rt {
@@ -33,7 +34,8 @@ void appendColumns(std::vector<Column>& columns, Column::Source source, const ch
 class RowBuilder {
  public:
   RowBuilder(const QdotModel& model, const std::vector<Column>& columns, std::span<const double> p)
-      : model_(model), columns_(columns), p_(p), values_(columns.size()) {
+      : model_(model), columns_(columns), p_(p), values_(columns.size()),
+        unwrap_(model.outputKinds ? std::span<const int32_t>(model.outputKinds, model.nOutputs) : std::span<const int32_t>()) {
     for (const Column& c : columns) {
       needOutputs_ |= c.source == Column::Source::Output;
       needInvariants_ |= c.source == Column::Source::Invariant;
@@ -42,8 +44,20 @@ class RowBuilder {
     invariants_.resize(model.nInvariants);
   }
 
+  /// Whether outputs are unwrapped (then every solver step should be observed).
+  bool unwraps() const { return needOutputs_ && unwrap_.active(); }
+
+  /// Follows the angle outputs through one solver step (no row is written).
+  void observe(double t, std::span<const double> y, std::span<const double> yp) {
+    evaluate(model_.outputs, "outputs", t, y, yp, outputs_);
+    unwrap_.apply(outputs_);
+  }
+
   std::span<const double> build(double t, std::span<const double> y, std::span<const double> yp) {
-    if (needOutputs_) evaluate(model_.outputs, "outputs", t, y, yp, outputs_);
+    if (needOutputs_) {
+      evaluate(model_.outputs, "outputs", t, y, yp, outputs_);
+      unwrap_.apply(outputs_);
+    }
     if (needInvariants_) evaluate(model_.invariants, "invariants", t, y, yp, invariants_);
     for (std::size_t i = 0; i < columns_.size(); ++i)
       values_[i] = value(columns_[i], y);
@@ -76,6 +90,7 @@ class RowBuilder {
   const std::vector<Column>& columns_;
   std::span<const double> p_;
   std::vector<double> values_, outputs_, invariants_;
+  AngleUnwrapper unwrap_;  ///< angle outputs continuous from row to row
   bool needOutputs_ = false, needInvariants_ = false;
 };
 
@@ -169,13 +184,17 @@ SimulationResult simulate(const QdotModel& model, const SimulationSettings& sett
                      settings.start);
     OutputGrid grid(settings.start, settings.stop, settings.interval);
     sink.begin(names);  // the header is written even if the setup fails
-    session = std::make_unique<IdaSession>(model, settings.parameters, sessionOptions(settings));
+    SessionOptions options = sessionOptions(settings);
+    RowBuilder rows(model, columns, settings.parameters);
+    options.observeSteps = rows.unwraps();
+    session = std::make_unique<IdaSession>(model, settings.parameters, options);
+    if (rows.unwraps())
+      session->setStepObserver([&rows](double t, std::span<const double> y, std::span<const double> yp) { rows.observe(t, y, yp); });
     session->initialize(grid[1]);
     session->setStopTime(settings.stop);
     result.setupSeconds = secondsSince(clock);
     clock = Clock::now();
     solving = true;
-    RowBuilder rows(model, columns, session->parameters());
     for (std::size_t k = 0; k < grid.size(); ++k) {
       double t = k == 0 ? session->time() : session->advanceTo(grid[k]);
       sink.row(t, rows.build(t, session->y(), session->yp()));
