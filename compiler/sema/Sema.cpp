@@ -258,6 +258,8 @@ class ClassChecker {
     ModelSymbol s;
     s.decl = &d;
     std::optional<BaseType> type = builtinType(dottedName(d.typeName));
+    const ClassDef* cls = type ? nullptr : model_.lookup().resolve(d.typeName, c_.cls);
+    if (cls && cls->kind == ClassKind::Type) type = BaseType::Real;  // type Length = Real(unit = "m")
     s.type = type.value_or(BaseType::Real);
     bool input = d.causality == Causality::Input && !d.isProtected;
     s.kind = input ? SymbolKind::Input : SymbolKind::Definition;
@@ -297,7 +299,7 @@ class ClassChecker {
     if (s.kind == SymbolKind::Component) return checkComponentDeclaration(d, s);
     for (const auto& mod : d.mods) checkModification(d, mod);
     if (d.binding) checkExpr(*d.binding);
-    checkKindRules(d, s);
+    if (!inFunction_) checkKindRules(d, s);  // a function's variables have their own (declareFunctionVariable)
   }
 
   void checkComponentDeclaration(const Declaration& d, const ModelSymbol& s) {
