@@ -222,6 +222,7 @@ struct Declaration {
   Causality causality = Causality::None;
   bool isCoordinate = false;
   bool isFlow = false;
+  bool isProtected = false;  ///< after `protected` in a function: a local variable
   std::vector<std::string> typeName;  ///< {"Real"}, {"Integer"}, {"Vibration", "Mass"}
   SourceRange typeRange;
   std::vector<ExprPtr> typeDims;  ///< `Real[3] x` (dims written on the type), usually empty

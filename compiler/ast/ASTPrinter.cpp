@@ -172,6 +172,7 @@ void TreePrinter::declaration(const Declaration& d, int indent) {
   if (d.causality == Causality::Output) os_ << " output";
   if (d.isFlow) os_ << " flow";
   if (d.isCoordinate) os_ << " coordinate";
+  if (d.isProtected) os_ << " protected";
   os_ << ' ' << join(d.typeName);
   if (!d.description.empty()) os_ << ' ' << quote(d.description, true);
   os_ << at(d.range) << '\n';

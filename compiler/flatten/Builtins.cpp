@@ -50,6 +50,7 @@ Value Flattener::lowerCall(const CallExpr& e) {
     for (Expr& x : v.elems) x = timeDerivative(x, e.range);
     return v;
   }
+  if (auto call = m_.calls.find(&e); call != m_.calls.end()) return lowerFunctionCall(call->second);
   for (const auto& u : kUnaryMath)
     if (name == u.name) return mapUnary(arg(0), u.kind);
   if (name == "sqrt" || name == "log10") {
