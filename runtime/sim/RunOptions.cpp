@@ -31,6 +31,11 @@ void addRunOptions(CLI::App& app, RunOptions& o) {
   app.add_flag("--invariants", o.invariants, "add the model's invariants (energy, momenta) as columns");
   app.add_option("--linear-solver", o.linearSolver, "dense, klu or auto (default auto)")
       ->check(CLI::IsMember({"auto", "dense", "klu"}));
+  // --solver (issue 11, section 3)
+  app.add_option("--solver", o.solver,
+                 "ida (BDF, any model; default), arkode (an L-stable ESDIRK method: models that are ODEs in their "
+                 "derivatives, e.g. stiff oscillations) or auto (chosen from the linearization at the start)")
+      ->check(CLI::IsMember({"ida", "arkode", "auto"}));
   app.add_option("--csv-names", o.csvNames,
                  "CSV header: modelica (der(x), x[1]; default) or identifier (der_x, x_1: for numpy and other "
                  "tools that take identifiers only)")
@@ -142,6 +147,10 @@ ResolvedRun resolveRunOptions(const RunOptions& o, const ExperimentDefaults& e, 
   if (!solver) throw UsageError(fmt::format("--linear-solver must be dense, klu or auto (got '{}')", o.linearSolver));
   s.linearSolver = *solver;
   s.invariants = o.invariants;
+  // --solver (issue 11, section 3)
+  auto integrator = parseSolver(o.solver);
+  if (!integrator) throw UsageError(fmt::format("--solver must be ida, arkode or auto (got '{}')", o.solver));
+  s.solver = *integrator;
   if (!o.outputs.empty()) s.columns = selectColumns(model, o.outputs, o.invariants);
   s.parameters = evaluateParameters(model, parameterOverrides(model, o.parameters));
   run.outputPath = o.outputPath;

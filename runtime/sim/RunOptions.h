@@ -30,6 +30,8 @@ struct RunOptions {
   bool invariants = false;              ///< --invariants
   std::string linearSolver = "auto";    ///< --linear-solver dense|klu|auto
   std::string csvNames = "modelica";    ///< --csv-names modelica|identifier
+  // --solver (issue 11, section 3)
+  std::string solver = "ida";  ///< --solver ida|arkode|auto
 };
 
 /// The model's experiment annotation, as far as it gives values.

@@ -13,6 +13,7 @@
 #include <memory>
 #include <set>
 
+#include "arkode/ArkodeSession.h"
 #include "ida/ModelCheck.h"
 #include "sim/Names.h"
 
@@ -89,7 +90,8 @@ SessionOptions sessionOptions(const SimulationSettings& s) {
   return o;
 }
 
-void collect(SimulationResult& r, const IdaSession& session) {
+template <class Session>
+void collect(SimulationResult& r, const Session& session) {
   r.tolerances = session.tolerances();
   r.linearSolver = session.linearSolver();
   r.computedInitialValues = session.computedInitialValues();
@@ -150,16 +152,18 @@ double OutputGrid::operator[](std::size_t k) const {
   return std::strtod(text, nullptr);
 }
 
-SimulationResult simulate(const QdotModel& model, const SimulationSettings& settings, ResultSink& sink) {
-  SimulationResult result;
-  result.failureTime = settings.start;
-  result.linearSolverChosenAutomatically = settings.linearSolver == LinearSolverKind::Auto;
+namespace {
+
+// The loop over the output grid with either integrator (IdaSession or ArkodeSession: the same face).
+template <class Session>
+SimulationResult simulateWith(const QdotModel& model, const SimulationSettings& settings, ResultSink& sink,
+                              SimulationResult result) {
   std::vector<Column> columns =
       settings.columns.empty() ? defaultColumns(model, settings.invariants) : settings.columns;
   std::vector<std::string> names;
   for (const Column& c : columns)
     names.push_back(c.name);
-  std::unique_ptr<IdaSession> session;
+  std::unique_ptr<Session> session;
   Clock::time_point clock = Clock::now();
   bool solving = false;
   try {
@@ -169,7 +173,7 @@ SimulationResult simulate(const QdotModel& model, const SimulationSettings& sett
                      settings.start);
     OutputGrid grid(settings.start, settings.stop, settings.interval);
     sink.begin(names);  // the header is written even if the setup fails
-    session = std::make_unique<IdaSession>(model, settings.parameters, sessionOptions(settings));
+    session = std::make_unique<Session>(model, settings.parameters, sessionOptions(settings));
     session->initialize(grid[1]);
     session->setStopTime(settings.stop);
     result.setupSeconds = secondsSince(clock);
@@ -197,8 +201,26 @@ SimulationResult simulate(const QdotModel& model, const SimulationSettings& sett
     if (result.success) result.message = e.what();
     result.success = false;
   }
+  std::vector<std::string> notes = std::move(result.warnings);
   if (session) collect(result, *session);
+  result.warnings.insert(result.warnings.begin(), notes.begin(), notes.end());
   return result;
+}
+
+}  // namespace
+
+SimulationResult simulate(const QdotModel& model, const SimulationSettings& settings, ResultSink& sink) {
+  SimulationResult result;
+  result.failureTime = settings.start;
+  result.linearSolverChosenAutomatically = settings.linearSolver == LinearSolverKind::Auto;
+  result.solver = settings.solver;
+  if (settings.solver == SolverKind::Auto) {
+    SolverChoice choice = chooseSolver(model, settings.parameters, settings.start, settings.stop);
+    result.solver = choice.kind;
+    result.warnings.push_back("note: --solver auto " + choice.reason);
+  }
+  if (result.solver == SolverKind::Arkode) return simulateWith<ArkodeSession>(model, settings, sink, std::move(result));
+  return simulateWith<IdaSession>(model, settings, sink, std::move(result));
 }
 
 }  // namespace qdot::rt
