@@ -30,8 +30,9 @@ constexpr std::size_t kMaxWarnings = 10;
 std::string_view likelyCause(int flag) {
   switch (flag) {
     case ARK_TOO_MUCH_WORK:
-      return "the step limit per output interval was reached: the model is stiffer or faster than the tolerance "
-             "allows to follow, or rtol is below what double precision can deliver";
+      return "the step limit per output interval was reached: the model oscillates faster than the tolerance allows "
+             "to follow, a velocity's tolerance lies below its round-off, or the stiffnesses lie more than about "
+             "1e15 apart, beyond double precision (model the stiff part as rigid)";
     case ARK_TOO_MUCH_ACC:
       return "the tolerances ask for more accuracy than double precision gives: raise --rtol or --atol";
     case ARK_ERR_FAILURE:

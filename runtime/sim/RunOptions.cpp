@@ -87,6 +87,16 @@ void checkTolerances(double rtol, std::optional<double> atol) {
   }
 }
 
+// issue 11, section 5: below a few ulps no integrator can deliver the relative accuracy asked for
+// (each step's rounding alone is larger), so the request is refused before anything runs.
+void checkRoundOffFloor(double rtol) {
+  if (rtol >= kRoundOffFloor) return;
+  throw UsageError(fmt::format("--rtol {:g} is below the round-off floor of double precision ({:.2g} = 10 × machine "
+                               "epsilon): every step's rounding is larger than that, so no solver can deliver it; use "
+                               "--rtol 1e-14 or larger (1e-10 already gives a tight reference solution)",
+                               rtol, kRoundOffFloor));
+}
+
 void checkTimes(double start, double stop, double interval) {
   requireFinite("--start", start);
   requireFinite("--stop", stop);
@@ -143,6 +153,7 @@ ResolvedRun resolveRunOptions(const RunOptions& o, const ExperimentDefaults& e, 
   s.rtol = o.rtol.value_or(e.tolerance.value_or(kDefaultRtol));
   s.atol = o.atol;
   checkTolerances(s.rtol, s.atol);
+  checkRoundOffFloor(s.rtol);
   auto solver = parseLinearSolver(o.linearSolver);
   if (!solver) throw UsageError(fmt::format("--linear-solver must be dense, klu or auto (got '{}')", o.linearSolver));
   s.linearSolver = *solver;
