@@ -56,7 +56,8 @@ class ExplicitForm {
   bool sparse_;
   std::vector<double> zeros_, residual_, at0_, at1_, massValues_;
   Eigen::SparseMatrix<double> mass_, stiffness_;  // A and F_y in the model's pattern
-  Eigen::PartialPivLU<Eigen::MatrixXd> denseLu_;
+  Eigen::PartialPivLU<Eigen::MatrixXd> denseLu_;  // of diag(rowScale_) · A
+  Eigen::VectorXd rowScale_;
   std::unique_ptr<Eigen::SparseLU<Eigen::SparseMatrix<double>>> sparseLu_;
   bool factored_ = false;
   long factorizations_ = 0;
