@@ -139,10 +139,10 @@ TEST(StiffForcedOscillator, StepsGrowAtMostThreefoldPerDecadeToRtol1e5) {
 // today the velocity's automatic scale is 1e-3 of the largest start position (1e-9 m/s here, while
 // ẋ is a small difference of 1e6 N forces: its round-off is about 1e-15 m/s), so at rtol ≤ 1e-8 its
 // tolerance lies below its round-off and the step count grows 3.8× (1e-5 → 1e-6), 5× and 6–10× per
-// decade (measured 3775, 14512, 73674, 451925 steps at 1e-5 … 1e-8; 1e-10 hits the step limit).
-// With the velocity's tolerance rtol × X·ω0 (= rtol × 1 m/s) the ladder measured 33, 116, 370, 675,
-// 1491, 3350, 5855 steps at rtol 1e-2, 1e-4, 1e-6 … 1e-10, and rtol 1e-6 took 0.008 s of solve
-// time against IDA's 10 s (today 0.24 s: 2.4 %).
+// decade (measured 3243 steps at 1e-5, then 14031, 73414, 431777 at 1e-6 … 1e-8; 1e-10 hits the
+// step limit). With the velocity's tolerance rtol × X·ω0 (= rtol × 1 m/s) the ladder measured 39,
+// 59, 95, 171, 318, 591, 1154, 2308, 4654 steps at rtol 1e-2 … 1e-10 (at most 1.9× per decade), and
+// rtol 1e-6 took 0.010 s of solve time against IDA's 10 s (today 0.27 s: 2.7 %).
 TEST(StiffForcedOscillator, DISABLED_StepsGrowAtMostThreefoldPerDecadeToRtol1e10) {
   expectLadder({1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10});
 }
