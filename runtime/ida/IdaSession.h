@@ -38,6 +38,7 @@ struct SessionOptions {
   std::optional<double> atol;  ///< user's absolute tolerance (before scaling); default rtol
   LinearSolverKind linearSolver = LinearSolverKind::Auto;
   long maxStepsPerOutput = 100000;  ///< IDASetMaxNumSteps: steps allowed per advanceTo call
+  bool preserveInvariants = false;  ///< --preserve invariants (ArkodeSession only): project after each step
 };
 
 /// Counters read from IDA after (or during) a run.

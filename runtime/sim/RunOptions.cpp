@@ -36,6 +36,10 @@ void addRunOptions(CLI::App& app, RunOptions& o) {
                  "ida (BDF, any model; default), arkode (an L-stable ESDIRK method: models that are ODEs in their "
                  "derivatives, e.g. stiff oscillations) or auto (chosen from the linearization at the start)")
       ->check(CLI::IsMember({"ida", "arkode", "auto"}));
+  app.add_option("--preserve", o.preserve,
+                 "invariants: after every step, project the state onto the start values of the model's invariants "
+                 "(energy, momenta); needs --solver arkode")
+      ->check(CLI::IsMember({"invariants"}));
   app.add_option("--csv-names", o.csvNames,
                  "CSV header: modelica (der(x), x[1]; default) or identifier (der_x, x_1: for numpy and other "
                  "tools that take identifiers only)")
@@ -162,6 +166,16 @@ ResolvedRun resolveRunOptions(const RunOptions& o, const ExperimentDefaults& e, 
   auto integrator = parseSolver(o.solver);
   if (!integrator) throw UsageError(fmt::format("--solver must be ida, arkode or auto (got '{}')", o.solver));
   s.solver = *integrator;
+  if (!o.preserve.empty() && o.preserve != "invariants")
+    throw UsageError(fmt::format("--preserve must be invariants (got '{}')", o.preserve));
+  s.preserveInvariants = o.preserve == "invariants";
+  if (s.preserveInvariants && s.solver != SolverKind::Arkode)
+    throw UsageError("--preserve invariants needs --solver arkode: the projection changes the state after every "
+                     "step, which a one-step method takes in its stride but which would invalidate IDA's multistep "
+                     "history");
+  if (s.preserveInvariants && model.nInvariants == 0)
+    throw UsageError("--preserve invariants: the model has no invariants (no energy or momentum is conserved: it is "
+                     "damped, forced or driven)");
   if (!o.outputs.empty()) s.columns = selectColumns(model, o.outputs, o.invariants);
   s.parameters = evaluateParameters(model, parameterOverrides(model, o.parameters));
   run.outputPath = o.outputPath;

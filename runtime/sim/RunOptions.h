@@ -32,6 +32,7 @@ struct RunOptions {
   std::string csvNames = "modelica";    ///< --csv-names modelica|identifier
   // --solver (issue 11, section 3)
   std::string solver = "ida";  ///< --solver ida|arkode|auto
+  std::string preserve;        ///< --preserve invariants (issue 11, section 4); "" = none
 };
 
 /// The model's experiment annotation, as far as it gives values.

@@ -87,6 +87,7 @@ SessionOptions sessionOptions(const SimulationSettings& s) {
   o.atol = s.atol;
   o.linearSolver = s.linearSolver;
   o.maxStepsPerOutput = s.maxStepsPerOutput;
+  o.preserveInvariants = s.preserveInvariants;
   return o;
 }
 

@@ -59,6 +59,7 @@ struct SimulationSettings {
   long maxStepsPerOutput = 100000;
   // --solver (issue 11, section 3): which integrator; Auto picks from the linearization at the start.
   SolverKind solver = SolverKind::Ida;
+  bool preserveInvariants = false;  ///< --preserve invariants: project onto their start values (arkode)
 };
 
 /// How a run went.

@@ -298,3 +298,42 @@ TEST(Pendulum, DISABLED_LengthScaleDoesNotChangeTheNondimensionalRun) {
 
 }  // namespace
 }  // namespace qdot::simtest
+
+namespace qdot::simtest {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Long runs that keep what the physics keeps (issue 11, section 4): the undamped oscillator
+// (models/undamped_oscillator.qd: x0 = 1, ω = 1) over 10 000 periods at rtol 1e-6 with
+// --preserve invariants. Reference: x = cos t, ẋ = −sin t, amplitude √(x² + ẋ²) = 1 (energy ½).
+// Bound: amplitude error ≤ 1e-6 at every row (measured 4e-16). Without the projection the same
+// method ends 2e-5 low (1.3e-4 at interpolated rows) and IDA 6.4e-2 low. The phase is not
+// corrected by an energy projection: measured −0.147 rad after 10 000 periods (IDA: +0.013 rad);
+// stated, with a bound of 0.5 rad so that a broken frequency is still caught.
+TEST(PreserveInvariants, UndampedOscillatorKeepsItsAmplitudeOverTenThousandPeriods) {
+  auto r = runQdot("tests/stability/models/undamped_oscillator.qd",
+                   {"--solver", "arkode", "--preserve", "invariants", "--rtol", "1e-6", "--interval", "5"});
+  ASSERT_EQ(r.exitCode, 0) << r.log;
+  const auto &t = r.time(), &x = r.col("x"), &v = r.col("der(x)");
+  double amplitudeError = 0;
+  for (std::size_t i = 0; i < r.rows; ++i) amplitudeError = std::max(amplitudeError, std::fabs(std::hypot(x[i], v[i]) - 1));
+  const double phase = std::remainder(std::atan2(-v.back(), x.back()) - t.back(), 2 * M_PI);
+  std::cout << "[measured] amplitude error " << amplitudeError << ", phase error after " << t.back() / (2 * M_PI)
+            << " periods " << phase << " rad\n";
+  EXPECT_LE(amplitudeError, 1e-6);
+  EXPECT_LT(std::fabs(phase), 0.5);
+}
+
+// --preserve invariants needs a one-step method and a model with invariants (usage errors, exit 2).
+TEST(PreserveInvariants, RefusedWhereItCannotWork) {
+  auto ida = runQdot("tests/stability/models/undamped_oscillator.qd", {"--preserve", "invariants", "--stop", "1"});
+  EXPECT_EQ(ida.exitCode, 2) << ida.log;
+  EXPECT_NE(ida.log.find("--preserve invariants needs --solver arkode"), std::string::npos) << ida.log;
+  auto damped = runQdot("tests/stability/models/damped_oscillator.qd",
+                        {"--solver", "arkode", "--preserve", "invariants", "--stop", "1"});
+  EXPECT_EQ(damped.exitCode, 2) << damped.log;
+  EXPECT_NE(damped.log.find("the model has no invariants"), std::string::npos) << damped.log;
+}
+
+}  // namespace
+}  // namespace qdot::simtest
