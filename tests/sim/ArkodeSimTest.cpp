@@ -2,6 +2,7 @@
 // L-stable ESDIRK method of runtime/arkode/ against the same references as IDA, the same CSV
 // columns, and the refusal of a model that is not an ODE in its derivatives.
 #include <cmath>
+#include <regex>
 
 #include "QdotRun.h"
 
@@ -99,14 +100,35 @@ TEST(Arkode, AutoSaysWhatItPickedAndWhy) {
   EXPECT_NE(dae.log.find("chose ida: its index was reduced"), std::string::npos) << dae.log;
 }
 
-// A failure keeps the rows and says when and why, as on IDA: the forced oscillator at rtol 1e-10
-// under today's velocity tolerance (README of tests/stability) exceeds the per-output step limit.
+// A failure keeps the rows and says when and why, as on IDA (tests/sim/models/ode_leaves_domain.qd:
+// x'' = −√x from x = 1 at rest). Reference: x reaches 0, where the force stops existing, at
+// t* = ∫₀¹ dx / √((4/3)(1 − x^(3/2))) (energy ½ẋ² + (2/3) x^(3/2) = 2/3), computed here with the
+// substitution x = (1 − u²)^(2/3) (1 − x^(3/2) = u², |dx| = (4/3) u (1 − u²)^(−1/3) du), which
+// removes the 1/√ singularity: t* = √(4/3) ∫₀¹ (1 − u²)^(−1/3) du = 1.49365 s, by the midpoint rule
+// on 10⁶ panels (the remaining (1 − u)^(−1/3) singularity costs below 1e-4).
+// Both solvers stop within 2e-3 s of t*, with the model's message, and keep the same rows.
 TEST(Arkode, FailureKeepsTheRowsAndNamesTheTime) {
-  auto r = runQdot("examples/benchmarks/stiff_forced_oscillator.qd", {"--solver", "arkode", "--rtol", "1e-10"});
-  EXPECT_EQ(r.exitCode, 3) << r.log;
-  EXPECT_NE(r.log.find("ARKStepEvolve failed (ARK_TOO_MUCH_WORK) at t = "), std::string::npos) << r.log;
-  EXPECT_NE(r.log.find("rows up to t = "), std::string::npos) << r.log;
-  EXPECT_GE(r.rows, 1u);
+  double integral = 0;
+  const int panels = 1000000;
+  for (int i = 0; i < panels; ++i) {
+    const double u = (i + 0.5) / panels;
+    integral += std::pow(1 - u * u, -1.0 / 3) / panels;
+  }
+  const double exact = std::sqrt(4.0 / 3) * integral;
+  std::vector<std::size_t> rows;
+  for (const char* solver : {"ida", "arkode"}) {
+    auto r = runQdot("tests/sim/models/ode_leaves_domain.qd", {"--solver", solver});
+    EXPECT_EQ(r.exitCode, 3) << r.log;
+    EXPECT_NE(r.log.find("sqrt of a negative number"), std::string::npos) << r.log;
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(r.log, m, std::regex("failed at t = ([0-9.e+-]+)"))) << r.log;
+    std::cout << "[measured] " << solver << " stops at " << m[1] << " s; x reaches 0 at " << num(exact) << " s\n";
+    EXPECT_NEAR(std::stod(m[1]), exact, 2e-3) << solver;
+    EXPECT_NE(r.log.find("rows up to t = "), std::string::npos) << r.log;
+    rows.push_back(r.rows);
+  }
+  EXPECT_EQ(rows[0], rows[1]);
+  EXPECT_GE(rows[0], 100u);
 }
 
 }  // namespace
