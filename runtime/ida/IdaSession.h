@@ -43,6 +43,7 @@ struct SessionOptions {
   /// observer sees every internal step: angle outputs are unwrapped along the whole trajectory,
   /// not only at output times that may not resolve a fast rotation.
   bool observeSteps = false;
+  bool preserveInvariants = false;  ///< --preserve invariants (ArkodeSession only): project after each step
 };
 
 /// Counters read from IDA after (or during) a run.

@@ -30,6 +30,9 @@ struct RunOptions {
   bool invariants = false;              ///< --invariants
   std::string linearSolver = "auto";    ///< --linear-solver dense|klu|auto
   std::string csvNames = "modelica";    ///< --csv-names modelica|identifier
+  // --solver (issue 11, section 3)
+  std::string solver = "ida";  ///< --solver ida|arkode|auto
+  std::string preserve;        ///< --preserve invariants (issue 11, section 4); "" = none
 };
 
 /// The model's experiment annotation, as far as it gives values.
@@ -40,6 +43,8 @@ struct ExperimentDefaults {
 inline constexpr double kDefaultStop = 1.0;       ///< s, without an experiment annotation
 inline constexpr double kDefaultIntervals = 500;  ///< output intervals over [start, stop]
 inline constexpr double kDefaultRtol = 1e-6;
+/// The smallest --rtol accepted: 10 × DBL_EPSILON (issue 11, section 5).
+inline constexpr double kRoundOffFloor = 10 * 2.220446049250313e-16;
 
 /// Adds --start --stop --interval --rtol --atol -p --outputs -o --stats --invariants
 /// --linear-solver --csv-names to app, storing into options (which must outlive the parse).

@@ -13,6 +13,7 @@
 #include <memory>
 #include <set>
 
+#include "arkode/ArkodeSession.h"
 #include "ida/ModelCheck.h"
 #include "output/AngleUnwrap.h"
 #include "sim/Names.h"
@@ -101,10 +102,12 @@ SessionOptions sessionOptions(const SimulationSettings& s) {
   o.atol = s.atol;
   o.linearSolver = s.linearSolver;
   o.maxStepsPerOutput = s.maxStepsPerOutput;
+  o.preserveInvariants = s.preserveInvariants;
   return o;
 }
 
-void collect(SimulationResult& r, const IdaSession& session) {
+template <class Session>
+void collect(SimulationResult& r, const Session& session) {
   r.tolerances = session.tolerances();
   r.linearSolver = session.linearSolver();
   r.computedInitialValues = session.computedInitialValues();
@@ -165,16 +168,18 @@ double OutputGrid::operator[](std::size_t k) const {
   return std::strtod(text, nullptr);
 }
 
-SimulationResult simulate(const QdotModel& model, const SimulationSettings& settings, ResultSink& sink) {
-  SimulationResult result;
-  result.failureTime = settings.start;
-  result.linearSolverChosenAutomatically = settings.linearSolver == LinearSolverKind::Auto;
+namespace {
+
+// The loop over the output grid with either integrator (IdaSession or ArkodeSession: the same face).
+template <class Session>
+SimulationResult simulateWith(const QdotModel& model, const SimulationSettings& settings, ResultSink& sink,
+                              SimulationResult result) {
   std::vector<Column> columns =
       settings.columns.empty() ? defaultColumns(model, settings.invariants) : settings.columns;
   std::vector<std::string> names;
   for (const Column& c : columns)
     names.push_back(c.name);
-  std::unique_ptr<IdaSession> session;
+  std::unique_ptr<Session> session;
   Clock::time_point clock = Clock::now();
   bool solving = false;
   try {
@@ -186,10 +191,14 @@ SimulationResult simulate(const QdotModel& model, const SimulationSettings& sett
     sink.begin(names);  // the header is written even if the setup fails
     SessionOptions options = sessionOptions(settings);
     RowBuilder rows(model, columns, settings.parameters);
-    options.observeSteps = rows.unwraps();
-    session = std::make_unique<IdaSession>(model, settings.parameters, options);
-    if (rows.unwraps())
-      session->setStepObserver([&rows](double t, std::span<const double> y, std::span<const double> yp) { rows.observe(t, y, yp); });
+    // Angle outputs follow every internal step where the session can show them (IDA); ARKODE's
+    // rows alone are unwrapped (an output interval must then resolve the rotation).
+    constexpr bool observable = requires(Session& s) { s.setStepObserver({}); };
+    options.observeSteps = observable && rows.unwraps();
+    session = std::make_unique<Session>(model, settings.parameters, options);
+    if constexpr (observable)
+      if (rows.unwraps())
+        session->setStepObserver([&rows](double t, std::span<const double> y, std::span<const double> yp) { rows.observe(t, y, yp); });
     session->initialize(grid[1]);
     session->setStopTime(settings.stop);
     result.setupSeconds = secondsSince(clock);
@@ -216,8 +225,26 @@ SimulationResult simulate(const QdotModel& model, const SimulationSettings& sett
     if (result.success) result.message = e.what();
     result.success = false;
   }
+  std::vector<std::string> notes = std::move(result.warnings);
   if (session) collect(result, *session);
+  result.warnings.insert(result.warnings.begin(), notes.begin(), notes.end());
   return result;
+}
+
+}  // namespace
+
+SimulationResult simulate(const QdotModel& model, const SimulationSettings& settings, ResultSink& sink) {
+  SimulationResult result;
+  result.failureTime = settings.start;
+  result.linearSolverChosenAutomatically = settings.linearSolver == LinearSolverKind::Auto;
+  result.solver = settings.solver;
+  if (settings.solver == SolverKind::Auto) {
+    SolverChoice choice = chooseSolver(model, settings.parameters, settings.start, settings.stop);
+    result.solver = choice.kind;
+    result.warnings.push_back("note: --solver auto " + choice.reason);
+  }
+  if (result.solver == SolverKind::Arkode) return simulateWith<ArkodeSession>(model, settings, sink, std::move(result));
+  return simulateWith<IdaSession>(model, settings, sink, std::move(result));
 }
 
 }  // namespace qdot::rt

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "arkode/SolverChoice.h"
 #include "ida/IdaSession.h"
 #include "output/ResultSink.h"
 #include "qdot/model_abi.h"
@@ -56,6 +57,9 @@ struct SimulationSettings {
   std::vector<Column> columns;     ///< empty = defaultColumns(model, invariants)
   bool invariants = false;         ///< with empty columns: add the invariant columns
   long maxStepsPerOutput = 100000;
+  // --solver (issue 11, section 3): which integrator; Auto picks from the linearization at the start.
+  SolverKind solver = SolverKind::Ida;
+  bool preserveInvariants = false;  ///< --preserve invariants: project onto their start values (arkode)
 };
 
 /// How a run went.
@@ -71,6 +75,7 @@ struct SimulationResult {
   bool linearSolverChosenAutomatically = false;            ///< --linear-solver auto
   bool computedInitialValues = false;
   std::vector<std::string> warnings;
+  SolverKind solver = SolverKind::Ida;  ///< the integrator that ran (never Auto)
   double setupSeconds = 0;  ///< wall time: session setup and consistent initial values
   double solveSeconds = 0;  ///< wall time: integration and writing
 };
