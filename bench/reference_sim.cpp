@@ -1,7 +1,7 @@
 // reference_sim: the hand-written reference programs of the simulation benchmark — the N-link
-// pendulum (dense) and the spring–damper chain (KLU), residual and Jacobian coded by hand
+// pendulum (dense), the spring–damper chain (KLU) and n free rigid bodies (KLU), residual and Jacobian coded by hand
 // (bench/reference/), integrated by SUNDIALS IDA exactly as `qdot run` integrates the .qd models.
-//   reference_sim nlink|chain --n N [--stop S] [--interval I] [--rtol R] [--atol A] [-o FILE]
+//   reference_sim nlink|chain|bodies --n N [--stop S] [--interval I] [--rtol R] [--atol A] [-o FILE]
 //                 [--outputs a,b] [--stats] [--repeat R] [--breakdown] [--json FILE]
 // --repeat runs the whole simulation R times and reports the fastest solve; --breakdown adds one
 // more run with the residual and Jacobian timed; --json writes the counters and times for
@@ -14,6 +14,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "reference/FreeBodies.h"
 #include "reference/IdaRun.h"
 #include "reference/NLinkPendulum.h"
 #include "reference/SpringChain.h"
@@ -38,6 +39,7 @@ struct Options {
 
 std::unique_ptr<ReferenceModel> makeModel(const Options& o) {
   if (o.model == "nlink") return std::make_unique<NLinkPendulum>(o.n > 0 ? o.n : 8);
+  if (o.model == "bodies") return std::make_unique<FreeBodies>(o.n > 0 ? o.n : 100);
   return std::make_unique<SpringChain>(o.n > 0 ? o.n : 10);
 }
 
@@ -45,7 +47,7 @@ std::unique_ptr<ReferenceModel> makeModel(const Options& o) {
 /// spring_chain.qd: StopTime 1, Interval 0.01) unless the stop is given, then 500 intervals.
 RunSettings settingsFor(const Options& o, const ReferenceModel& model) {
   RunSettings s;
-  s.stop = o.stop.value_or(o.model == "nlink" ? 5.0 : 1.0);
+  s.stop = o.stop.value_or(o.model == "nlink" ? 5.0 : 1.0);  // bodies: rigid_bench.py gives --stop
   s.interval = o.interval.value_or(o.stop ? (s.stop - s.start) / 500 : 0.01);
   s.rtol = o.rtol;
   s.atol = o.atol;
@@ -84,7 +86,7 @@ void writeJson(const std::string& path, const RunResult& r, const std::vector<do
 int main(int argc, char** argv) {
   CLI::App app{"Hand-written IDA reference programs for bench/ (N-link pendulum, spring chain)"};
   Options o;
-  app.add_option("model", o.model, "nlink or chain")->required()->check(CLI::IsMember({"nlink", "chain"}));
+  app.add_option("model", o.model, "nlink, chain or bodies")->required()->check(CLI::IsMember({"nlink", "chain", "bodies"}));
   app.add_option("--n", o.n, "links (nlink, default 8) or masses (chain, default 10)");
   app.add_option("--stop", o.stop, "stop time [s]");
   app.add_option("--interval", o.interval, "output interval [s]");

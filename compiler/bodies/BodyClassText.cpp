@@ -76,7 +76,7 @@ std::string fixedPointPart(const BodyShape& s) {
   std::string io = s.hasCm ? "Icm + mass*((cm*cm)*identity(3) - {cm[i]*cm[j] for i in 1:3, j in 1:3})" : "Icm";
   std::string pe = s.hasCm ? " - mass*(gravity*(R*cm))" : "";
   return fmt::format(
-      "  parameter Real Io[3, 3] = {} \"inertia about the fixed point, body axes [kg m2]\";\n"
+      "  Real Io[3, 3] = {} \"inertia about the fixed point, body axes [kg m2]\";\n"
       "  Real omega[3](each start = 0, each fixed = true) \"angular velocity, body axes [rad/s]\";\n"
       "{}{}"
       "  output Real L[3] = R*(Io*omega) \"angular momentum about the fixed point, world axes [N m s]\";\n"
@@ -111,12 +111,16 @@ std::string bodyClassText(const BodyShape& s) {
   std::string head = fmt::format(
       "model {} \"rigid body {} (generated from its body declaration)\"\n"
       "  parameter Real mass \"mass [kg]\";\n"
-      "  parameter Real Icm[3, 3] \"inertia about the centre of mass, body axes [kg m2]\";\n"
+      "{}"
       "{}"
       "  parameter Real gravity[3] = {{0, 0, 0}} \"gravitational acceleration, world axes [m/s2]\";\n"
       "{}"
       "  Real q[4](start = {{1, 0, 0, 0}}, each fixed = true) \"orientation: unit quaternion body to world, scalar first\";\n",
       s.className, s.bodyName,
+      // Principal moments stay three parameters and Icm a definition, so its zeros fold away.
+      s.principal ? "  parameter Real inertia[3] \"principal moments of inertia about the centre of mass [kg m2]\";\n"
+                    "  Real Icm[3, 3] = diagonal(inertia) \"inertia about the centre of mass, body axes\";\n"
+                  : "  parameter Real Icm[3, 3] \"inertia about the centre of mass, body axes [kg m2]\";\n",
       s.hasCm ? "  parameter Real cm[3] \"centre of mass from the reference point, body axes [m]\";\n" : "",
       inputs(s));
   return head + (s.fixedPoint ? fixedPointPart(s) : freeBodyPart(s)) + fmt::format("end {};\n", s.className);

@@ -12,6 +12,7 @@ struct BodyShape {
   std::string bodyName;    ///< `top`
   bool fixedPoint = false; ///< motion about the fixed reference point (else a free body)
   bool hasCm = false;      ///< `cm` given (else the reference point is the centre of mass)
+  bool principal = false;  ///< inertia given as principal moments (parameter inertia[3], Icm diagonal)
   bool torqueBody = false, torqueWorld = false;
   int forces = 0;          ///< force k (1-based) has inputs force<k>[3] (world) and at<k>[3] (body)
 };

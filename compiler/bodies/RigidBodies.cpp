@@ -219,7 +219,7 @@ class ClassLowering {
         hasMass |= m.name == "mass";
         hasInertia |= m.name == "inertia";
         s.hasCm |= m.name == "cm";
-        if (m.name == "inertia") ok &= lowerInertia(m);
+        if (m.name == "inertia") ok &= lowerInertia(m, s);
         mods.push_back(std::move(m));
       } else if (m.name == "q" || m.name == "omega" || m.name == "r" || m.name == "v") {
         if (m.value) {
@@ -247,21 +247,15 @@ class ClassLowering {
     return ok && hasMass && hasInertia;
   }
 
-  // `inertia = {I1, I2, I3}` (principal moments) becomes Icm = diagonal({…}); a matrix is Icm itself.
-  bool lowerInertia(Modification& m) {
-    m.name = "Icm";
+  // `inertia = {I1, I2, I3}` (principal moments) stays `inertia`; a matrix becomes Icm.
+  bool lowerInertia(Modification& m, BodyShape& s) {
     auto* arr = dyn_cast<ArrayExpr>(m.value.get());
     bool principal = arr && arr->elements.size() == 3 &&
                      std::none_of(arr->elements.begin(), arr->elements.end(), [](const ExprPtr& e) { return isa<ArrayExpr>(e.get()); });
     std::optional<Eigen::Matrix3d> known = knownInertia(m.value.get(), principal);
     if (known && !checkInertia(*known, m.value->range)) return false;
-    if (principal) {
-      SourceRange r = m.value->range;
-      std::vector<ExprPtr> args;
-      args.push_back(std::move(m.value));
-      auto callee = std::make_unique<NameExpr>(r, std::vector<std::string>{"diagonal"}, std::vector<SourceRange>{r});
-      m.value = std::make_unique<CallExpr>(r, std::move(callee), std::move(args), std::vector<NamedArg>{});
-    }
+    s.principal = principal;
+    if (!principal) m.name = "Icm";
     return true;
   }
 

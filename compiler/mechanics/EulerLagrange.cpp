@@ -205,7 +205,9 @@ class Deriver {
         out_.integrals.push_back(
             {FirstIntegral::Kind::CyclicMomentum, row.coordinate, "p(" + std::string(coord.name) + ")", row.momentum});
     }
-    if (!conservative) return;
+    // Without coordinates there is no Lagrangian whose energy could be conserved (a model of
+    // equations or rigid bodies only): a Jacobi integral would be the constant 0.
+    if (!conservative || out_.rows.empty()) return;
     jacobi.push_back(ctx_.neg(ctx_.add(lagrangian_.terms)));
     out_.integrals.push_back({FirstIntegral::Kind::Jacobi, -1, "jacobi", ctx_.add(jacobi)});
   }

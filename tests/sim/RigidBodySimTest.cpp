@@ -184,5 +184,22 @@ TEST(RigidBodies, QuaternionNormDoesNotDriftOverTenThousandRevolutions) {
   EXPECT_LE(maxDeviation(r.col("disk.omega[3]"), 20 * kPi), 1e-6 * 20 * kPi);
 }
 
+// cart_and_body.qd: a cart coordinate (M = 2) and a free body (m = 1) joined by a spring k = 50,
+// stretched 0.1 m at rest: the stretch s = b.r[1] − x − 1 oscillates as 0.1 cos(ω t), ω² = k (1/M +
+// 1/m); the total momentum M der(x) + m v[1] stays 0 and the spin stays 5 rad/s about the z axis.
+TEST(RigidBodies, CartCoordinateAndBodyOscillateAgainstEachOther) {
+  const double rtol = 1e-9, M = 2, m = 1, k = 50, w = std::sqrt(k * (1 / M + 1 / m));
+  auto r = runRigid("examples/rigid/cart_and_body.qd", rtol);
+  const auto& t = r.time();
+  const auto& x = r.col("x");
+  const auto& rb = r.col("b.r[1]");
+  double worst = 0;
+  for (std::size_t i = 0; i < t.size(); ++i)
+    worst = std::max(worst, std::fabs(rb[i] - x[i] - 1 - 0.1 * std::cos(w * t[i])) / oscillationBound(rtol, 0.1, 2 * kPi / w, t[i]));
+  EXPECT_LE(worst, 1) << "stretch against 0.1 cos(ω t), in units of the oscillation bound";
+  EXPECT_LE(maxDeviation(r.col("momentum"), 0), 100 * rtol * m * 0.1 * w);
+  EXPECT_LE(maxDeviation(r.col("b.omega[3]"), 5), 1e-9);
+}
+
 }  // namespace
 }  // namespace qdot::simtest
