@@ -407,6 +407,32 @@ Expr Simplifier::operator()(Expr e) {
 
 Expr simplify(Context& ctx, Expr e, SimplifyLevel level) { return Simplifier(ctx, level)(e); }
 
+bool worthSimplifying(Expr e, SimplifyLevel level) {
+  if (level != SimplifyLevel::Fast) return level == SimplifyLevel::Full;
+  NodeSet seen;
+  SmallVec<Expr, 32> stack;
+  stack.push_back(e);
+  while (!stack.empty()) {
+    Expr n = stack.back();
+    stack.pop_back();
+    if (!n->symbolMask || !seen.insert(n)) continue;
+    switch (n->kind) {
+      case Kind::Sin: case Kind::Cos: case Kind::Tan: case Kind::Sinh: case Kind::Cosh: case Kind::Tanh:
+      case Kind::Exp: case Kind::Log: return true;
+      case Kind::Pow:
+        if (!n->args[1]->isConstant() || !isIntegerValue(n->args[1]->value)) return true;
+        break;
+      case Kind::Mul:
+        for (Expr x : n->exps)
+          if (!x->isConstant() || !isIntegerValue(x->value)) return true;
+        break;
+      default: break;
+    }
+    for (Expr c : children(n)) stack.push_back(c);
+  }
+  return false;
+}
+
 size_t expressionCost(Expr e) {
   NodeMap<size_t> cost;
   constexpr size_t kCap = size_t{1} << 40;

@@ -48,6 +48,11 @@ class Simplifier {
 /// One expression at one level.
 Expr simplify(Context& ctx, Expr e, SimplifyLevel level = SimplifyLevel::Fast);
 
+/// Whether the level simplifies e at all: None never, Full always, Fast when e contains a
+/// trigonometric, hyperbolic, exp or log function or a non-integer power (where the identities
+/// apply; a pure polynomial such as a spring energy only gets longer when expanded). O(DAG size).
+bool worthSimplifying(Expr e, SimplifyLevel level);
+
 /// The length measure the simplifier minimises: the number of operations, leaves and non-unit
 /// coefficients of e written out as a tree (shared subexpressions counted at each use).
 size_t expressionCost(Expr e);
