@@ -71,6 +71,7 @@ class Deriver {
   DiagnosticEngine& diags_;
   sym::SimplifyLevel level_;
   sym::Simplifier simplifier_;
+  bool energiesSimplified_ = true;  ///< no energy ran out of the simplifier's budget
   TermIndex lagrangian_, dissipation_;
   std::vector<std::vector<Expr>> forces_;  ///< by flat variable: the generalized forces on it
   EquationsOfMotion out_;
@@ -97,7 +98,9 @@ class Deriver {
         checkEnergyVariables(t);
       }
     }
-    if (!together.empty()) addSummands(idx, simplifier_(ctx_.add(together)), sign);
+    if (together.empty()) return;
+    addSummands(idx, simplifier_(ctx_.add(together)), sign);
+    energiesSimplified_ &= !simplifier_.gaveUp();
   }
 
   bool addSummands(TermIndex& idx, Expr e, double sign) {
@@ -116,7 +119,9 @@ class Deriver {
     return true;
   }
 
-  Expr simplified(Expr e) { return sym::worthSimplifying(e, level_) ? simplifier_(e) : e; }
+  // Rows, momenta and integrals are simplified only when the energies were: derived from energies
+  // too large for the budget, they would exceed it too, and trying would only cost time.
+  Expr simplified(Expr e) { return energiesSimplified_ && sym::worthSimplifying(e, level_) ? simplifier_(e) : e; }
 
   // Returns false if the term contains a variable an energy may not depend on.
   bool addTerm(TermIndex& idx, Expr term) {

@@ -51,6 +51,10 @@ Mono multiplyMonos(const Mono& a, const Mono& b) {
 
 struct OverBudget {};
 
+// Monomials a fast call may create besides 8 per input node: the 32-link pendulum's kinetic energy
+// (2·Σ i² ≈ 23 000 products of the velocities' terms) fits, the 64-link's (175 000) does not.
+constexpr size_t kFastBudget = 40000;
+
 }  // namespace
 
 /// A sum of coefficient·monomial with an index of the monomials (terms keep their insertion order).
@@ -97,6 +101,7 @@ struct Simplifier::Impl {
   Context& ctx;
   SimplifyLevel level;
   size_t work = 0, budget = 0;
+  bool gaveUp = false;  ///< the last call ran out of budget
   NodeMap<Expr> memo;       ///< node -> simplifyExpr's result (subexpressions, function arguments)
   NodeMap<Expr> functions;  ///< function node -> its canonical form as an atom of a polynomial
 
@@ -392,15 +397,18 @@ bool parseSimplifyLevel(std::string_view text, SimplifyLevel& level) {
 Simplifier::Simplifier(Context& ctx, SimplifyLevel level) : impl_(std::make_unique<Impl>(ctx, level)) {}
 Simplifier::~Simplifier() = default;
 size_t Simplifier::work() const { return impl_->work; }
+bool Simplifier::gaveUp() const { return impl_->gaveUp; }
 
 Expr Simplifier::operator()(Expr e) {
   Impl& s = *impl_;
   if (s.level == SimplifyLevel::None || e->kind == Kind::Constant || e->kind == Kind::Symbol) return e;
   size_t size = s.ctx.dagSize({&e, 1});
-  s.budget = s.work + (s.level == SimplifyLevel::Full ? 100000 + 64 * size : 64 + 8 * size);
+  s.budget = s.work + (s.level == SimplifyLevel::Full ? 1000000 + 64 * size : kFastBudget + 8 * size);
+  s.gaveUp = false;
   try {
     return s.simplifyExpr(e);
   } catch (const OverBudget&) {
+    s.gaveUp = true;
     return e;
   }
 }

@@ -36,6 +36,8 @@ class Simplifier {
 
   /// The simplified e (e itself at level None, past the budget, or when nothing is shorter).
   Expr operator()(Expr e);
+  /// Whether the last call ran out of budget (and so returned its input).
+  bool gaveUp() const;
   /// Monomials created so far (the budgeted work), for benchmarks and tests.
   size_t work() const;
 
