@@ -77,21 +77,21 @@ sym::Expr initialValueOf(const Dae& dae, const Variable& v) {
   return nullptr;
 }
 
-// The textbook's order of an Euler–Lagrange row: terms with an acceleration (a derivative symbol
-// that is no unknown itself), then with a velocity (an unknown that is another's derivative), then
-// the rest.
+// The textbook's order of an Euler–Lagrange row: terms with an acceleration (the derivative
+// symbol of a velocity), then with a velocity, then the rest.
 std::function<int(sym::Expr)> textbookOrder(const Dae& dae, const sym::Context& ctx) {
-  auto ys = std::make_shared<std::unordered_set<sym::Expr>>(), yps = std::make_shared<std::unordered_set<sym::Expr>>();
+  auto accelerations = std::make_shared<std::unordered_set<sym::Expr>>();
+  auto velocities = std::make_shared<std::unordered_set<sym::Expr>>();
   for (const auto& v : dae.variables) {
-    ys->insert(v.y);
-    if (v.yp) yps->insert(v.yp);
+    if (v.role != UnknownRole::Velocity) continue;
+    velocities->insert(v.y);
+    if (v.yp) accelerations->insert(v.yp);
   }
-  return [ys, yps, &ctx](sym::Expr term) {
+  return [accelerations, velocities, &ctx](sym::Expr term) {
     int g = 2;
     for (sym::Expr s : ctx.freeSymbols(term)) {
-      if (!yps->count(s)) continue;
-      if (!ys->count(s)) return 0;
-      g = 1;
+      if (accelerations->count(s)) return 0;
+      if (velocities->count(s)) g = 1;
     }
     return g;
   };
