@@ -58,27 +58,42 @@ constexpr size_t kFastBudget = 40000;
 }  // namespace
 
 /// A sum of coefficient·monomial with an index of the monomials (terms keep their insertion order).
+/// The index maps a monomial's hash to the first term with it, terms with equal hashes are chained:
+/// a monomial is stored once, and adding to an existing term allocates nothing.
 struct Poly {
+  static constexpr uint32_t kEnd = UINT32_MAX;
   struct Term {
     Mono mono;
     double coef;
+    uint32_t next = kEnd;  ///< next term with the same hash
   };
   std::vector<Term> terms;
-  std::unordered_map<Mono, size_t, MonoHash> index;
+  std::unordered_map<size_t, uint32_t> index;
 
-  void add(Mono m, double c) {
-    if (c == 0.0) return;
-    auto [it, fresh] = index.try_emplace(m, terms.size());
-    if (fresh) terms.push_back({std::move(m), c});
-    else terms[it->second].coef += c;
+  Term* find(const Mono& m, size_t h) {
+    auto it = index.find(h);
+    for (uint32_t i = it == index.end() ? kEnd : it->second; i != kEnd; i = terms[i].next)
+      if (terms[i].mono == m) return &terms[i];
+    return nullptr;
   }
-  const Term* find(const Mono& m) const {
-    auto it = index.find(m);
-    return it == index.end() ? nullptr : &terms[it->second];
+  Term* find(const Mono& m) { return find(m, MonoHash{}(m)); }
+  template <class M = Mono>
+  void add(M&& m, double c) {
+    if (c == 0.0) return;
+    size_t h = MonoHash{}(m);
+    if (Term* t = find(m, h)) {
+      t->coef += c;
+      return;
+    }
+    auto [it, fresh] = index.try_emplace(h, static_cast<uint32_t>(terms.size()));
+    uint32_t next = fresh ? kEnd : it->second;
+    if (!fresh) it->second = static_cast<uint32_t>(terms.size());
+    terms.push_back({Mono(std::forward<M>(m)), c, next});
   }
   /// Drops terms whose coefficients cancelled.
   void compact() {
     Poly out;
+    out.terms.reserve(terms.size());
     for (Term& t : terms)
       if (t.coef != 0.0) out.add(std::move(t.mono), t.coef);
     *this = std::move(out);
@@ -342,9 +357,9 @@ struct Simplifier::Impl {
     for (size_t k = 0; k < m.size(); ++k)
       if (k != i && k != j) rest.push_back(m[k]);
     Mono partnerMono = multiplyMonos(rest, sortedPair(ctx.unary(other(ki), a), ctx.unary(other(kj), b)));
-    auto it = p.index.find(partnerMono);
-    if (it == p.index.end()) return nullptr;
-    Poly::Term& partner = p.terms[it->second];
+    Poly::Term* found = p.find(partnerMono);
+    if (!found) return nullptr;
+    Poly::Term& partner = *found;
     double c = p.terms[ti].coef, d = partner.coef;
     if (d != c && d != -c) return nullptr;
     bool same = d == c;
