@@ -393,8 +393,12 @@ struct Simplifier::Impl {
       p.compact();
       p = contractAngles(pythagorean(std::move(p)));
       r = toExpr(p);
-      if (Expr f = factoredExpr(p); f && expressionCost(f) < expressionCost(r)) r = f;
-      if (expressionCost(r) >= expressionCost(e)) r = e;
+      size_t cost = expressionCost(r);
+      if (Expr f = factoredExpr(p)) {
+        size_t factored = expressionCost(f);
+        if (factored < cost) r = f, cost = factored;
+      }
+      if (cost >= expressionCost(e)) r = e;
     }
     memo.insert(e, r);
     return r;
