@@ -434,6 +434,38 @@ Expr Simplifier::operator()(Expr e) {
 
 Expr simplify(Context& ctx, Expr e, SimplifyLevel level) { return Simplifier(ctx, level)(e); }
 
+namespace {
+
+// Whether u is a ± b of two symbols (coefficients ±1, no constant).
+bool isSymbolPair(Expr u) {
+  return u->kind == Kind::Add && u->value == 0.0 && u->args.size() == 2 && u->args[0]->isSymbol() &&
+         u->args[1]->isSymbol() && std::abs(u->coefs[0]) == 1.0 && std::abs(u->coefs[1]) == 1.0;
+}
+
+// sin/cos(k0 a + k1 b) with k = ±1, from sin(k a) = k sin a and cos(k a) = cos a.
+Expr expandedAngle(Context& ctx, Expr f) {
+  Expr u = f->args[0], a = u->args[0], b = u->args[1];
+  double ka = u->coefs[0], kb = u->coefs[1];
+  Expr sa = ctx.scale(ka, ctx.unary(Kind::Sin, a)), ca = ctx.unary(Kind::Cos, a);
+  Expr sb = ctx.scale(kb, ctx.unary(Kind::Sin, b)), cb = ctx.unary(Kind::Cos, b);
+  if (f->kind == Kind::Sin) return ctx.add(ctx.mul(sa, cb), ctx.mul(ca, sb));
+  return ctx.sub(ctx.mul(ca, cb), ctx.mul(sa, sb));
+}
+
+}  // namespace
+
+std::vector<Expr> expandAngleDifferences(Context& ctx, std::span<const Expr> roots) {
+  std::unordered_map<Expr, Expr> map;
+  PostOrder po = postOrder(roots);
+  for (Expr n : po.order)
+    if ((n->kind == Kind::Sin || n->kind == Kind::Cos) && isSymbolPair(n->args[0])) map.emplace(n, expandedAngle(ctx, n));
+  std::vector<Expr> out(roots.begin(), roots.end());
+  if (map.empty()) return out;
+  uint64_t mask = Context::keyMaskOf(map);
+  for (Expr& e : out) e = ctx.substitute(e, map, mask);
+  return out;
+}
+
 bool worthSimplifying(Expr e, SimplifyLevel level) {
   if (level != SimplifyLevel::Fast) return level == SimplifyLevel::Full;
   NodeSet seen;

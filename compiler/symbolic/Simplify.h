@@ -11,7 +11,9 @@
 
 #include <cstddef>
 #include <memory>
+#include <span>
 #include <string_view>
+#include <vector>
 
 #include "symbolic/Expr.h"
 
@@ -49,6 +51,12 @@ class Simplifier {
 
 /// One expression at one level.
 Expr simplify(Context& ctx, Expr e, SimplifyLevel level = SimplifyLevel::Fast);
+
+/// For evaluation: sin(a ± b) and cos(a ± b) of two symbols written as products of sin and cos of
+/// each (sin a cos b ± cos a sin b, cos a cos b ∓ sin a sin b), so that a kernel computes sin and cos
+/// of every angle once and shares them, as a hand-written N-link residual does, instead of calling
+/// sin and cos once per difference (n² calls for an n-link pendulum). Returns the rewritten roots.
+std::vector<Expr> expandAngleDifferences(Context& ctx, std::span<const Expr> roots);
 
 /// Whether the level simplifies e at all: None never, Full always, Fast when e contains a
 /// trigonometric, hyperbolic, exp or log function or a non-integer power (where the identities

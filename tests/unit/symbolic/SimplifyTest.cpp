@@ -172,3 +172,25 @@ TEST(SimplifyRandom, AgreesWithTheOriginal) {
 }
 
 }  // namespace
+
+namespace {
+
+// For kernels: sin/cos of a ± b (two symbols) as products of sin and cos of each, same values.
+TEST(ExpandAngleDifferences, WritesDifferencesThroughEachAngle) {
+  Context ctx;
+  Expr a = ctx.symbol("a"), b = ctx.symbol("b"), x = ctx.symbol("x");
+  Expr d = ctx.sub(a, b), s = ctx.add(a, b), nd = ctx.sub(b, a);
+  std::vector<Expr> roots{ctx.mul(x, ctx.unary(Kind::Sin, d)), ctx.unary(Kind::Cos, d), ctx.unary(Kind::Sin, s),
+                          ctx.unary(Kind::Cos, s), ctx.unary(Kind::Sin, nd), ctx.unary(Kind::Sin, ctx.scale(2, a))};
+  std::vector<Expr> out = expandAngleDifferences(ctx, roots);
+  EXPECT_EQ(toString(ctx, out[1]), "sin(a)*sin(b) + cos(a)*cos(b)");
+  EXPECT_EQ(out[5], roots[5]);  // sin(2a) is not a pair of symbols
+  std::vector<double> values(ctx.symbolCount());
+  values[a->symbolId] = 0.7, values[b->symbolId] = -1.3, values[x->symbolId] = 2.5;
+  for (size_t i = 0; i < roots.size(); ++i) {
+    EXPECT_NEAR(evaluate(out[i], values), evaluate(roots[i], values), 1e-15) << toString(ctx, roots[i]);
+    EXPECT_FALSE(toString(ctx, out[i]).find("a - b") != std::string::npos) << toString(ctx, out[i]);
+  }
+}
+
+}  // namespace
