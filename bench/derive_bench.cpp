@@ -1,7 +1,8 @@
 // Derivation benchmark: wall time from model text to the assembled DAE (parse, check, flatten,
 // Euler–Lagrange, DAE) for the N-link pendulum (dense mass matrix) and the spring chain (sparse),
 // across sizes, with the growth exponent between successive sizes. Best of several repetitions.
-// Usage: derive_bench [--quick]   (run from the repository root, or set QDOT_SOURCE_DIR)
+// Usage: derive_bench [--quick] [--simplify=none|fast|full]   (run from the repository root, or set
+// QDOT_SOURCE_DIR); --simplify as in qdot (default fast).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -19,6 +20,8 @@
 namespace {
 
 using namespace qdot;
+
+sym::SimplifyLevel simplifyLevel = sym::SimplifyLevel::Fast;
 
 std::string readFile(const std::string& path) {
   std::ifstream in(path);
@@ -43,6 +46,7 @@ Sample measure(const std::string& text, int repetitions) {
   for (int r = 0; r < repetitions; ++r) {
     auto t0 = std::chrono::steady_clock::now();
     driver::Compilation c;
+    c.options.simplify = simplifyLevel;
     bool ok = driver::compileSource(c, "bench.qd", text, "", driver::Stage::Dae);
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!ok) {
@@ -86,10 +90,17 @@ void runSeries(const char* title, const std::string& file, const std::vector<int
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool quick = argc > 1 && std::string(argv[1]) == "--quick";
+  bool quick = false;
+  std::string level = "fast";
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    if (a == "--quick") quick = true;
+    else if (a.rfind("--simplify=", 0) == 0 && sym::parseSimplifyLevel(a.substr(11), simplifyLevel)) level = a.substr(11);
+    else return std::fprintf(stderr, "usage: derive_bench [--quick] [--simplify=none|fast|full]\n"), 2;
+  }
   const char* root = std::getenv("QDOT_SOURCE_DIR");
   std::string dir = root ? std::string(root) + "/" : "";
-  std::printf("## Derivation: model text to DAE (best of several runs)\n");
+  std::printf("## Derivation: model text to DAE (best of several runs), --simplify=%s\n", level.c_str());
   runSeries("N-link pendulum, dense", dir + "examples/pendulum/nlink.qd",
             quick ? std::vector<int>{2, 4, 8, 16} : std::vector<int>{2, 4, 8, 16, 32, 64}, 30);
   runSeries("Spring–damper chain, sparse", dir + "examples/vibration/spring_chain.qd",

@@ -4,6 +4,9 @@
 #include "dae/Dae.h"
 
 #include <algorithm>
+#include <functional>
+#include <memory>
+#include <unordered_set>
 
 namespace qdot::dae {
 namespace {
@@ -74,6 +77,26 @@ sym::Expr initialValueOf(const Dae& dae, const Variable& v) {
   return nullptr;
 }
 
+// The textbook's order of an Euler–Lagrange row: terms with an acceleration (the derivative
+// symbol of a velocity), then with a velocity, then the rest.
+std::function<int(sym::Expr)> textbookOrder(const Dae& dae, const sym::Context& ctx) {
+  auto accelerations = std::make_shared<std::unordered_set<sym::Expr>>();
+  auto velocities = std::make_shared<std::unordered_set<sym::Expr>>();
+  for (const auto& v : dae.variables) {
+    if (v.role != UnknownRole::Velocity) continue;
+    velocities->insert(v.y);
+    if (v.yp) accelerations->insert(v.yp);
+  }
+  return [accelerations, velocities, &ctx](sym::Expr term) {
+    int g = 2;
+    for (sym::Expr s : ctx.freeSymbols(term)) {
+      if (accelerations->count(s)) return 0;
+      if (velocities->count(s)) g = 1;
+    }
+    return g;
+  };
+}
+
 }  // namespace
 
 void printEquations(std::ostream& os, const Dae& dae, const sym::Context& ctx, const SourceManager& sm) {
@@ -81,9 +104,10 @@ void printEquations(std::ostream& os, const Dae& dae, const sym::Context& ctx, c
   if (!dae.description.empty()) os << " \"" << dae.description << "\"";
   os << "\n\n";
   if (!dae.rowCoordinates.empty()) os << "Euler-Lagrange equations (d/dt dL/dder(q) - dL/dq + dD/dder(q) = Q):\n";
+  std::function<int(sym::Expr)> order = textbookOrder(dae, ctx);
   for (size_t row = 0; row < dae.rowCoordinates.size(); ++row) {
     const Equation& e = dae.equations[row];
-    os << "  " << dae.rowCoordinates[row] << ":  " << sym::toString(ctx, e.residual) << " = 0\n";
+    os << "  " << dae.rowCoordinates[row] << ":  " << sym::toStringGrouped(ctx, e.residual, order) << " = 0\n";
     os << "      (" << where(sm, e.origin.range) << ")\n";
   }
   bool header = false;

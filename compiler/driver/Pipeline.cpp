@@ -66,7 +66,7 @@ bool flatten(Compilation& c) {
 }
 
 bool derive(Compilation& c) {
-  c.eom = timed(c.times.derive, [&] { return mech::deriveEquationsOfMotion(*c.flat, c.ctx, c.diags); });
+  c.eom = timed(c.times.derive, [&] { return mech::deriveEquationsOfMotion(*c.flat, c.ctx, c.diags, c.options.simplify); });
   return c.eom && !c.diags.hasErrors();
 }
 

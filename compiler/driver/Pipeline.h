@@ -27,6 +27,7 @@
 #include "sema/Sema.h"
 #include "support/Diagnostic.h"
 #include "symbolic/Expr.h"
+#include "symbolic/Simplify.h"
 
 namespace qdot::driver {
 
@@ -47,6 +48,7 @@ struct CompileOptions {
   flat::FlattenLimits limits;   ///< size limits of flattening (tests and fuzzing lower them)
   flat::StructuralValues structural;  ///< values of Integer parameters (see takeStructuralParameters)
   llvmbackend::JitOptions jit;  ///< what Stage::Native compiles, and how
+  sym::SimplifyLevel simplify = sym::SimplifyLevel::Fast;  ///< `--simplify`: of the derived equations
   /// Results asked for (`--outputs`): the DAE stage keeps only what they need (dae/Prune.h); empty:
   /// everything. keepInvariants keeps every invariant (and what it needs) as well (`--invariants`).
   std::vector<std::string> results;

@@ -27,6 +27,7 @@ struct Options {
   std::string file;
   std::string model;
   std::string emit;      // --emit=STAGE: print that stage's output and stop
+  std::string simplify = "fast";  // --simplify=none|fast|full
   bool json = false;     // equations --json
   bool timings = false;  // check/equations --timings
   bool quiet = false;    // check --quiet
@@ -220,6 +221,7 @@ ExitCode linearize(driver::Compilation& c, Options& o) {
 ExitCode dispatch(Action action, Options& o) {
   driver::Compilation c;
   c.options.model = o.model;
+  sym::parseSimplifyLevel(o.simplify, c.options.simplify);  // checked by CLI11
   if (!o.emit.empty()) return emitStage(c, o);
   switch (action) {
     case Action::Check: return check(c, o);
@@ -241,6 +243,9 @@ CLI::App* addCommand(CLI::App& app, const char* name, const char* help, Options&
   cmd->add_option("--model", o.model, "the model (default: the last model in the file)");
   cmd->add_option("--emit", o.emit, "print a stage's output and stop: " + driver::emitStageList())
       ->check(CLI::IsMember(driver::emitStageNames()));
+  cmd->add_option("--simplify", o.simplify,
+                  "simplification of the derived equations: none, fast (default: within a budget) or full")
+      ->check(CLI::IsMember({"none", "fast", "full"}));
   return cmd;
 }
 

@@ -11,6 +11,7 @@
 #include "kernel/Jacobian.h"
 #include "kernel/Lowering.h"
 #include "support/Diagnostic.h"
+#include "symbolic/Simplify.h"
 
 namespace qdot::kernel {
 namespace {
@@ -358,6 +359,7 @@ class Builder {
       roots.push_back(e.residual);
     }
     roots.insert(roots.end(), jac.values.begin(), jac.values.end());
+    roots = sym::expandAngleDifferences(ctx_, roots);  // sin/cos of each angle once, shared
     sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, roots, "$t");
     m_.sharedTemporaries = cse.temporaries.size();
     size_t n = dae_.equations.size() + initialRows_.size();

@@ -16,6 +16,19 @@ std::string at(const SourceManager& sm, SourceRange r) {
 
 std::string text(const sym::Context& ctx, sym::Expr e) { return e ? sym::toString(ctx, e) : "0"; }
 
+// The textbook's order of a row's terms: accelerations (the mass matrix), then velocities, then the
+// rest (potential, forces).
+int group(const flat::FlatModel& model, const sym::Context& ctx, sym::Expr term) {
+  int g = 2;
+  for (sym::Expr s : ctx.freeSymbols(term)) {
+    int var = model.variableOf(s);
+    if (var < 0) continue;
+    if (model.variables[var].role == flat::VarRole::Acceleration) return 0;
+    if (model.variables[var].role == flat::VarRole::Velocity) g = 1;
+  }
+  return g;
+}
+
 const char* kindName(FirstIntegral::Kind k) {
   return k == FirstIntegral::Kind::CyclicMomentum ? "cyclic momentum" : "Jacobi integral";
 }
@@ -32,7 +45,9 @@ void printEquationsOfMotion(std::ostream& os, const EquationsOfMotion& eom, cons
      << "):\n";
   for (const CoordinateRow& row : eom.rows) {
     const flat::Variable& q = model.variables[row.coordinate];
-    os << "  " << q.name << ": " << text(ctx, row.residual) << " = 0" << at(sm, q.declRange) << "\n";
+    auto byGroup = [&](sym::Expr term) { return group(model, ctx, term); };
+    os << "  " << q.name << ": " << (row.residual ? sym::toStringGrouped(ctx, row.residual, byGroup) : "0") << " = 0"
+       << at(sm, q.declRange) << "\n";
     os << "      momentum p(" << q.name << ") = " << text(ctx, row.momentum) << (row.inertial ? "" : ", no inertia")
        << "\n";
   }

@@ -45,7 +45,8 @@ class TermIndex {
 
 class Deriver {
  public:
-  Deriver(const flat::FlatModel& m, sym::Context& ctx, DiagnosticEngine& diags) : m_(m), ctx_(ctx), diags_(diags) {}
+  Deriver(const flat::FlatModel& m, sym::Context& ctx, DiagnosticEngine& diags, sym::SimplifyLevel level)
+      : m_(m), ctx_(ctx), diags_(diags), level_(level), simplifier_(ctx, level) {}
 
   std::optional<EquationsOfMotion> run() {
     size_t errorsBefore = diags_.errorCount();
@@ -58,9 +59,9 @@ class Deriver {
     for (int q : m_.variablesWithRole(VarRole::Coordinate)) derive(q);
     if (diags_.errorCount() > errorsBefore) return std::nullopt;
     findFirstIntegrals();
-    out_.kinetic = total(m_.kinetic);
-    out_.potential = total(m_.potential);
-    out_.dissipation = total(m_.dissipation);
+    out_.kinetic = simplified(total(m_.kinetic));
+    out_.potential = simplified(total(m_.potential));
+    out_.dissipation = simplified(total(m_.dissipation));
     return std::move(out_);
   }
 
@@ -68,6 +69,9 @@ class Deriver {
   const flat::FlatModel& m_;
   sym::Context& ctx_;
   DiagnosticEngine& diags_;
+  sym::SimplifyLevel level_;
+  sym::Simplifier simplifier_;
+  bool energiesSimplified_ = true;  ///< no energy ran out of the simplifier's budget
   TermIndex lagrangian_, dissipation_;
   std::vector<std::vector<Expr>> forces_;  ///< by flat variable: the generalized forces on it
   EquationsOfMotion out_;
@@ -82,18 +86,42 @@ class Deriver {
   // Splits every statement into its top-level summands and records which variables each contains.
   // The summands hold exactly the statement's symbols, so the energy check looks at those; only a
   // statement that fails it is walked again, to report its symbols in order of appearance.
+  // Statements worth simplifying are simplified together (the terms of x, y and z of one mass cancel
+  // across statements too); their variables are checked statement by statement first.
   void index(TermIndex& idx, const std::vector<flat::Term>& terms, double sign) {
+    std::vector<Expr> together;
     for (const auto& t : terms) {
-      const sym::Node* e = t.value;
-      bool allowed = true;
-      if (e->kind == sym::Kind::Add) {
-        for (size_t i = 0; i < e->args.size(); ++i) allowed &= addTerm(idx, ctx_.scale(sign * e->coefs[i], e->args[i]));
-      } else if (!e->isConstant()) {
-        allowed = addTerm(idx, ctx_.scale(sign, e));
+      if (sym::worthSimplifying(t.value, level_)) {
+        if (!energyVariablesAllowed(t.value)) checkEnergyVariables(t);
+        together.push_back(t.value);
+      } else if (!addSummands(idx, t.value, sign)) {
+        checkEnergyVariables(t);
       }
-      if (!allowed) checkEnergyVariables(t);
     }
+    if (together.empty()) return;
+    addSummands(idx, simplifier_(ctx_.add(together)), sign);
+    energiesSimplified_ &= !simplifier_.gaveUp();
   }
+
+  bool addSummands(TermIndex& idx, Expr e, double sign) {
+    bool allowed = true;
+    if (e->kind == sym::Kind::Add) {
+      for (size_t i = 0; i < e->args.size(); ++i) allowed &= addTerm(idx, ctx_.scale(sign * e->coefs[i], e->args[i]));
+    } else if (!e->isConstant()) {
+      allowed = addTerm(idx, ctx_.scale(sign, e));
+    }
+    return allowed;
+  }
+
+  bool energyVariablesAllowed(Expr e) {
+    for (Expr s : ctx_.freeSymbols(e))
+      if (int var = m_.variableOf(s); var >= 0 && !mayAppearInEnergy(m_.variables[var].role)) return false;
+    return true;
+  }
+
+  // Rows, momenta and integrals are simplified only when the energies were: derived from energies
+  // too large for the budget, they would exceed it too, and trying would only cost time.
+  Expr simplified(Expr e) { return energiesSimplified_ && sym::worthSimplifying(e, level_) ? simplifier_(e) : e; }
 
   // Returns false if the term contains a variable an energy may not depend on.
   bool addTerm(TermIndex& idx, Expr term) {
@@ -182,7 +210,7 @@ class Deriver {
       return;
     }
     bool inertial = !lagrangian_.termsOf(v).empty();
-    out_.rows.push_back({q, residual, p, inertial});
+    out_.rows.push_back({q, simplified(residual), simplified(p), inertial});
   }
 
   void findFirstIntegrals() {
@@ -209,15 +237,15 @@ class Deriver {
     // equations or rigid bodies only): a Jacobi integral would be the constant 0.
     if (!conservative || out_.rows.empty()) return;
     jacobi.push_back(ctx_.neg(ctx_.add(lagrangian_.terms)));
-    out_.integrals.push_back({FirstIntegral::Kind::Jacobi, -1, "jacobi", ctx_.add(jacobi)});
+    out_.integrals.push_back({FirstIntegral::Kind::Jacobi, -1, "jacobi", simplified(ctx_.add(jacobi))});
   }
 };
 
 }  // namespace
 
 std::optional<EquationsOfMotion> deriveEquationsOfMotion(const flat::FlatModel& model, sym::Context& ctx,
-                                                         DiagnosticEngine& diags) {
-  return Deriver(model, ctx, diags).run();
+                                                         DiagnosticEngine& diags, sym::SimplifyLevel simplify) {
+  return Deriver(model, ctx, diags, simplify).run();
 }
 
 }  // namespace qdot::mech

@@ -5,6 +5,8 @@
 // the accelerations. Also finds the first integrals (cyclic momenta, the Jacobi integral).
 // Costs grow with the size of the energies: derivatives are taken only of the energy terms that
 // contain the coordinate (an index from symbols to terms), never of the whole Lagrangian.
+// Energies with trigonometric terms are simplified first (sin² + cos² = 1, angle sums), so a
+// Lagrangian written with Cartesian positions has the same terms as the textbook's.
 #pragma once
 
 #include <optional>
@@ -14,6 +16,7 @@
 #include "flatten/FlatModel.h"
 #include "support/Diagnostic.h"
 #include "symbolic/Expr.h"
+#include "symbolic/Simplify.h"
 
 namespace qdot::mech {
 
@@ -48,8 +51,12 @@ struct EquationsOfMotion {
   sym::Expr kinetic = nullptr, potential = nullptr, dissipation = nullptr;  ///< totals T, V, D
 };
 
-/// Derives the rows; reports located errors (E04xx) and returns nullopt on failure.
+/// Derives the rows; reports located errors (E04xx) and returns nullopt on failure. At `simplify`
+/// (sym/Simplify.h) the energies are simplified before they are differentiated (so cyclic
+/// coordinates and time-independence are judged on the simplified Lagrangian), and the rows, the
+/// momenta and the first integrals after.
 std::optional<EquationsOfMotion> deriveEquationsOfMotion(const flat::FlatModel& model, sym::Context& ctx,
-                                                         DiagnosticEngine& diags);
+                                                         DiagnosticEngine& diags,
+                                                         sym::SimplifyLevel simplify = sym::SimplifyLevel::Fast);
 
 }  // namespace qdot::mech

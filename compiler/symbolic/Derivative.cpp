@@ -127,7 +127,27 @@ Expr dAtan(const Diff& D, Expr u, Expr du) {
 Expr dSinh(const Diff& D, Expr u, Expr du) { return D.chain(D.ctx.unary(Kind::Cosh, u), du); }
 Expr dCosh(const Diff& D, Expr u, Expr du) { return D.chain(D.ctx.unary(Kind::Sinh, u), du); }
 Expr dExp(const Diff& D, Expr, Expr du) { return D.chain(D.node, du); }
-Expr dLog(const Diff& D, Expr u, Expr du) { return D.ctx.div(du, u); }
+// log' = u'/u, in forms that stay finite where u overflows (|v| > 710): log(cosh v)' = tanh(v) v',
+// log(sinh v)' = v'/tanh(v), log(c + k exp v)' = k v'/(c exp(−v) + k) (log(exp v)' = v' already,
+// since u' = exp(v) v' cancels). v' is u' over the outer derivative, which the builders cancel exactly.
+Expr dLog(const Diff& D, Expr u, Expr du) {
+  Context& c = D.ctx;
+  if (du->isZero()) return du;
+  if (u->kind == Kind::Cosh) {
+    Expr v = u->args[0];
+    return c.mul(c.unary(Kind::Tanh, v), c.div(du, c.unary(Kind::Sinh, v)));
+  }
+  if (u->kind == Kind::Sinh) {
+    Expr v = u->args[0];
+    return c.div(c.div(du, c.unary(Kind::Cosh, v)), c.unary(Kind::Tanh, v));
+  }
+  if (u->kind == Kind::Add && u->args.size() == 1 && u->args[0]->kind == Kind::Exp) {
+    Expr e = u->args[0], v = e->args[0];
+    Expr denominator = c.add(c.scale(u->value, c.unary(Kind::Exp, c.neg(v))), c.constant(u->coefs[0]));
+    return c.div(c.div(du, e), denominator);
+  }
+  return c.div(du, u);
+}
 Expr dAbs(const Diff& D, Expr u, Expr du) { return D.chain(D.ctx.unary(Kind::Sign, u), du); }
 
 // atan2(y, x)' = (x*dy - y*dx) / (x^2 + y^2)

@@ -255,6 +255,11 @@ int structuralCompare(Expr a, Expr b);
 /// in canonical order with a leading minus as ` - `, the constant term last (`x - 1`).
 std::string toString(const Context& ctx, Expr e);
 
+/// toString with the terms of the top-level sum (or of the one sum factor of a top-level product,
+/// `m*l*(...)`) ordered by group(term), lowest first, canonical order within a group: the equations
+/// of motion print mass-matrix terms, then velocity terms, then potential and forces.
+std::string toStringGrouped(const Context& ctx, Expr e, const std::function<int(Expr term)>& group);
+
 // --- common-subexpression elimination ----------------------------------------------------------
 
 /// The result of CSE over a set of outputs: temporaries in evaluation order (each value uses only

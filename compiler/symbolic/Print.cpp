@@ -4,7 +4,9 @@
 // `if c then a else b`. Term and factor order is the canonical (structural) order of the node.
 #include <cmath>
 #include <deque>
+#include <functional>
 #include <string_view>
+#include <vector>
 
 #include "symbolic/ContextImpl.h"
 #include "qdot/number_text.hpp"
@@ -66,6 +68,8 @@ struct Task {
 class Printer {
  public:
   explicit Printer(const Context& ctx) : ctx_(ctx) {}
+  /// Prints the terms of the sum `s` ordered by group(term) (stable: canonical order within one).
+  Printer(const Context& ctx, Expr s, const std::function<int(Expr)>& group) : ctx_(ctx), grouped_(s), group_(&group) {}
 
   std::string run(Expr root) {
     stack_.push_back({"", root, IfExpr});
@@ -149,9 +153,17 @@ class Printer {
   }
 
   void sum(Expr n) {
-    for (size_t i = 0; i < n->args.size(); ++i) {
+    std::vector<size_t> order(n->args.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    if (n == grouped_) {
+      std::vector<int> g(order.size());
+      for (size_t i = 0; i < order.size(); ++i) g[i] = (*group_)(n->args[i]);
+      std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return g[a] < g[b]; });
+    }
+    for (size_t k = 0; k < order.size(); ++k) {
+      size_t i = order[k];
       double c = n->coefs[i];
-      if (i > 0) text(c < 0.0 ? " - " : " + ");
+      if (k > 0) text(c < 0.0 ? " - " : " + ");
       else if (c < 0.0) text("-");
       term(std::fabs(c), n->args[i]);
     }
@@ -222,6 +234,8 @@ class Printer {
   }
 
   const Context& ctx_;
+  Expr grouped_ = nullptr;
+  const std::function<int(Expr)>* group_ = nullptr;
   std::vector<Task> stack_, seq_;
   std::deque<std::string> numbers_;  // storage behind number Tasks (stable addresses)
   std::string out_;
@@ -230,5 +244,17 @@ class Printer {
 }  // namespace
 
 std::string toString(const Context& ctx, Expr e) { return Printer(ctx).run(e); }
+
+std::string toStringGrouped(const Context& ctx, Expr e, const std::function<int(Expr term)>& group) {
+  Expr sum = e->kind == Kind::Add ? e : nullptr;
+  if (e->kind == Kind::Mul) {
+    for (size_t i = 0; i < e->args.size(); ++i) {
+      if (e->args[i]->kind != Kind::Add || !e->exps[i]->isOne()) continue;
+      if (sum) return toString(ctx, e);  // two sum factors: no one sum to order
+      sum = e->args[i];
+    }
+  }
+  return Printer(ctx, sum, group).run(e);
+}
 
 }  // namespace qdot::sym

@@ -92,3 +92,21 @@ TEST_F(Print, MechanicsStyle) {
 }
 
 }  // namespace
+
+namespace {
+
+// toStringGrouped: the terms of the top-level sum (or of the one sum factor of a product) by group.
+TEST(PrintGrouped, OrdersTheTermsOfTheOuterSumByGroup) {
+  Context ctx;
+  Expr x = ctx.symbol("x"), y = ctx.symbol("y"), z = ctx.symbol("z"), m = ctx.symbol("m");
+  Expr sum = ctx.add(std::vector<Expr>{x, ctx.scale(-2, y), z});
+  auto zFirst = [&](Expr t) { return t == z ? 0 : t == y ? 1 : 2; };
+  EXPECT_EQ(toString(ctx, sum), "x - 2*y + z");
+  EXPECT_EQ(toStringGrouped(ctx, sum, zFirst), "z - 2*y + x");
+  EXPECT_EQ(toStringGrouped(ctx, ctx.mul(m, sum), zFirst), "m*(z - 2*y + x)");
+  EXPECT_EQ(toStringGrouped(ctx, ctx.neg(sum), zFirst), "-(z - 2*y + x)");
+  // not a sum: as toString
+  EXPECT_EQ(toStringGrouped(ctx, ctx.mul(m, x), zFirst), toString(ctx, ctx.mul(m, x)));
+}
+
+}  // namespace
