@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -56,7 +57,12 @@ struct SimulationSettings {
   std::vector<Column> columns;     ///< empty = defaultColumns(model, invariants)
   bool invariants = false;         ///< with empty columns: add the invariant columns
   long maxStepsPerOutput = 100000;
+  std::optional<long> maxSteps;        ///< steps allowed over the whole run (--max-steps); none = no limit
+  std::ostream* progress = nullptr;    ///< a terminal: progress once the run is longer than kProgressAfter
 };
+
+/// Seconds of solving after which progress is shown (when SimulationSettings::progress is set).
+inline constexpr double kProgressAfter = 3.0;
 
 /// How a run went.
 struct SimulationResult {
