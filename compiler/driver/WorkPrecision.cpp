@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
 
 #include "driver/Backends.h"
 #include "driver/WorkPrecisionExact.h"

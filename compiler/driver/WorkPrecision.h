@@ -41,8 +41,9 @@ void addWorkPrecisionOptions(CLI::App& cmd, WorkPrecisionOptions& options);
 
 /// Runs the study on a compilation that reached Stage::Kernel (modelPath names the model file, for
 /// the default output names and the report). Table on out; errors and notes on log. Returns
-/// Usage for a bad option or reference, ModelError for a bad --exact expression, Success otherwise
-/// (a run that fails is a row of the table, not a failure of the study).
+/// Usage for a bad option, reference or --exact expression (a located diagnostic),
+/// SimulationFailed when the tight reference run fails, Success otherwise (a run of the ladder that
+/// fails is a row of the table, not a failure of the study).
 ExitCode workPrecision(Compilation& c, const std::string& modelPath, const WorkPrecisionOptions& options,
                        std::ostream& out, std::ostream& log);
 

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 
@@ -199,6 +200,9 @@ std::optional<ExactSolution> parseExact(const std::string& text, const std::vect
   std::shared_ptr<ast::StoredDefinition> tree = syntax::parse(wrapperSources, wrapper, wrapperDiags);
   const ast::Expr* expr = wrapperDiags.hasErrors() ? nullptr : bindingOf(*tree);
   if (expr) Evaluator(0.0, names, &wrapperDiags).value(*expr);  // the check: names, functions, forms
+  else if (!wrapperDiags.hasErrors())  // e.g. a right side that ends the declaration early
+    wrapperDiags.error({wrapper, static_cast<uint32_t>(kWrapperHead.size()), static_cast<uint32_t>(kWrapperHead.size())},
+                       DiagCode::E0290, "--exact expects an expression after '='", "e.g. --exact 'x = 0.05*cos(20*time)'");
   for (const Diagnostic& d : wrapperDiags.diagnostics())
     diags.report(relocated(d, file, static_cast<uint32_t>(eq + 1), static_cast<uint32_t>(value.size())));
   if (wrapperDiags.hasErrors() || !expr) return std::nullopt;
