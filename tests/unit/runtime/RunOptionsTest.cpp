@@ -113,6 +113,19 @@ TEST(RunOptionsValidation, TimesMustMakeASpan) {
             "the stop time (1) must be greater than the start time (5)");
 }
 
+// The output-size guard counts rows before anything runs (an interval of 1e-300 is refused, not an
+// overflow); --force lets a large but intended output through.
+TEST(RunOptionsValidation, MoreThanTenMillionRowsNeedForce) {
+  EXPECT_EQ(usageError({"--stop", "10", "--interval", "1e-9"}),
+            "--interval 1e-09 would write 1e+10 rows over [0, 10] (more than 1e+07); give a longer --interval, or "
+            "--force if that many rows are meant");
+  EXPECT_NE(usageError({"--interval", "1e-300"}).find("would write 1e+300 rows"), std::string::npos);
+  EXPECT_EQ(usageError({"--interval", "1e-7"}), "(no error)");  // 10^7 + 1 rows: just at the limit
+  EXPECT_EQ(usageError({"--stop", "10", "--interval", "1e-9", "--force"}), "(no error)");
+  EXPECT_EQ(usageError({"--max-steps", "0"}), "--max-steps must be positive (got 0)");
+  EXPECT_EQ(resolve({"--max-steps", "20"}).settings.maxSteps, 20);
+}
+
 TEST(RunOptionsValidation, ParameterMistakes) {
   EXPECT_EQ(usageError({"-p", "omgea=3"}), "unknown parameter 'omgea' (did you mean 'omega'?)");
   EXPECT_EQ(usageError({"-p", "zeta=3"}), "unknown parameter 'zeta'; the model has: omega");
