@@ -102,9 +102,10 @@ void checkTimes(double start, double stop, double interval) {
 void checkRowCount(double start, double stop, double interval, bool force) {
   double rows = std::floor((stop - start) / interval) + 1;
   if (rows <= kMaxRowsWithoutForce || force) return;
-  throw UsageError(fmt::format("--interval {} would write {:.4g} rows over [{}, {}] (more than {:.0e}); give a longer "
+  std::string count = rows < 1e15 ? fmt::format("{:.0f}", rows) : fmt::format("{:.3g}", rows);
+  throw UsageError(fmt::format("--interval {} would write {} rows over [{}, {}] (more than {:.0e}); give a longer "
                                "--interval, or --force if that many rows are meant",
-                               interval, rows, start, stop, kMaxRowsWithoutForce));
+                               interval, count, start, stop, kMaxRowsWithoutForce));
 }
 
 }  // namespace

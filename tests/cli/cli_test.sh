@@ -143,7 +143,7 @@ done
 # Guards (issue 11 §5): an --interval that would write 10^10 rows is refused with the count; with
 # --max-steps the run stops with an error naming the limit and keeps the rows written so far.
 check rows-refused 2 "$qdot" run "$src/examples/textbook/utube.qd" --interval 1e-9
-contains rows-count "would write 1e+10 rows" "$qdot" run "$src/examples/textbook/utube.qd" --interval 1e-9
+contains rows-count "would write 10000000001 rows" "$qdot" run "$src/examples/textbook/utube.qd" --interval 1e-9
 check max-steps 3 "$qdot" run "$src/examples/textbook/utube.qd" --max-steps 50
 contains max-steps-message "reached --max-steps 50" "$qdot" run "$src/examples/textbook/utube.qd" --max-steps 50
 contains max-steps-rows "rows up to t =" "$qdot" run "$src/examples/textbook/utube.qd" --max-steps 50

@@ -117,10 +117,11 @@ TEST(RunOptionsValidation, TimesMustMakeASpan) {
 // overflow); --force lets a large but intended output through.
 TEST(RunOptionsValidation, MoreThanTenMillionRowsNeedForce) {
   EXPECT_EQ(usageError({"--stop", "10", "--interval", "1e-9"}),
-            "--interval 1e-09 would write 1e+10 rows over [0, 10] (more than 1e+07); give a longer --interval, or "
+            "--interval 1e-09 would write 10000000001 rows over [0, 10] (more than 1e+07); give a longer --interval, or "
             "--force if that many rows are meant");
   EXPECT_NE(usageError({"--interval", "1e-300"}).find("would write 1e+300 rows"), std::string::npos);
-  EXPECT_EQ(usageError({"--interval", "1e-7"}), "(no error)");  // 10^7 + 1 rows: just at the limit
+  EXPECT_NE(usageError({"--interval", "1e-7"}).find("would write 10000001 rows"), std::string::npos);
+  EXPECT_EQ(usageError({"--interval", "2e-7"}), "(no error)");  // 5 000 001 rows
   EXPECT_EQ(usageError({"--stop", "10", "--interval", "1e-9", "--force"}), "(no error)");
   EXPECT_EQ(usageError({"--max-steps", "0"}), "--max-steps must be positive (got 0)");
   EXPECT_EQ(resolve({"--max-steps", "20"}).settings.maxSteps, 20);
