@@ -1,4 +1,4 @@
-# qdot_runtime: the SUNDIALS IDA session (ida/), the simulation loop and run options (sim/) and the
+# qdot_runtime: the SUNDIALS IDA session (ida/), the ARKODE session (arkode/), the simulation loop and run options (sim/) and the
 # result writers (output/). Included by runtime/CMakeLists.txt, which globs RUNTIME_SOURCES.
 # Links SUNDIALS 6.4 (Debian's shared libraries) with the dense and KLU direct linear solvers.
 find_package(SUNDIALS REQUIRED CONFIG)
@@ -9,7 +9,7 @@ add_library(qdot_runtime STATIC ${RUNTIME_SOURCES})
 target_include_directories(qdot_runtime PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include ${CMAKE_CURRENT_SOURCE_DIR})
 target_link_libraries(qdot_runtime
   PUBLIC fmt::fmt CLI11::CLI11 Threads::Threads
-  PRIVATE Eigen3::Eigen SUNDIALS::ida_shared SUNDIALS::nvecserial_shared SUNDIALS::sunmatrixdense_shared
+  PRIVATE Eigen3::Eigen SUNDIALS::ida_shared SUNDIALS::arkode_shared SUNDIALS::nvecserial_shared SUNDIALS::sunmatrixdense_shared
           SUNDIALS::sunmatrixsparse_shared SUNDIALS::sunlinsoldense_shared SUNDIALS::sunlinsolklu_shared)
 
 # qdot_exe_main: the main of standalone model executables (exe/, `qdot build`). qdot links it,

@@ -222,6 +222,7 @@ struct Declaration {
   Causality causality = Causality::None;
   bool isCoordinate = false;
   bool isFlow = false;
+  bool isProtected = false;  ///< after `protected` in a function: a local variable
   std::vector<std::string> typeName;  ///< {"Real"}, {"Integer"}, {"Vibration", "Mass"}
   SourceRange typeRange;
   std::vector<ExprPtr> typeDims;  ///< `Real[3] x` (dims written on the type), usually empty
@@ -272,14 +273,16 @@ struct Equation {
 // The mechanics section (spec §5)
 // ---------------------------------------------------------------------------------------------
 
-enum class MechanicsKind { Kinetic, Potential, Dissipation, Force, Constraint, For };
+enum class MechanicsKind { Kinetic, Potential, Dissipation, Force, Constraint, For, Gravity, Torque };
 
 struct MechanicsStmt {
   MechanicsKind kind;
   SourceRange range;
   SourceRange keywordRange;
-  ExprPtr target;  ///< Force: the coordinate (NameExpr or IndexExpr) inside `force(...)`
-  ExprPtr value;   ///< Kinetic/Potential/Dissipation/Force: the rhs; Constraint: lhs
+  ExprPtr target;  ///< Force/Torque: the coordinate or body (NameExpr or IndexExpr) inside `force(...)`
+  ExprPtr value;   ///< Kinetic/Potential/Dissipation/Force/Gravity/Torque: the rhs; Constraint: lhs
+  ExprPtr at;      ///< Force on a body: `force(b, at = {…})`, the point in body axes (null: the centre of mass)
+  bool world = false;  ///< Torque: `torque(b, world) = …` (world axes; else body axes)
   ExprPtr rhs;     ///< Constraint: rhs
   std::vector<Iterator> iterators;  ///< For
   std::vector<MechanicsStmt> body;  ///< For

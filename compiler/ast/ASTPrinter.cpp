@@ -75,6 +75,8 @@ const char* mechanicsName(MechanicsKind k) {
     case MechanicsKind::Force: return "force";
     case MechanicsKind::Constraint: return "constraint";
     case MechanicsKind::For: return "for";
+    case MechanicsKind::Gravity: return "gravity";
+    case MechanicsKind::Torque: return "torque";
   }
   return "?";
 }
@@ -170,6 +172,7 @@ void TreePrinter::declaration(const Declaration& d, int indent) {
   if (d.causality == Causality::Output) os_ << " output";
   if (d.isFlow) os_ << " flow";
   if (d.isCoordinate) os_ << " coordinate";
+  if (d.isProtected) os_ << " protected";
   os_ << ' ' << join(d.typeName);
   if (!d.description.empty()) os_ << ' ' << quote(d.description, true);
   os_ << at(d.range) << '\n';
@@ -218,7 +221,8 @@ void TreePrinter::equation(const Equation& eq, int indent) {
 
 void TreePrinter::mechanics(const MechanicsStmt& s, int indent) {
   line(indent) << "Mechanics " << mechanicsName(s.kind) << at(s.range) << '\n';
-  if (s.kind == MechanicsKind::Force) expr(s.target.get(), indent + 1, "target");
+  if (s.kind == MechanicsKind::Force || s.kind == MechanicsKind::Torque) expr(s.target.get(), indent + 1, "target");
+  if (s.at) expr(s.at.get(), indent + 1, "at");
   if (s.kind != MechanicsKind::For) expr(s.value.get(), indent + 1, s.kind == MechanicsKind::Constraint ? "lhs" : "value");
   if (s.kind == MechanicsKind::Constraint) expr(s.rhs.get(), indent + 1, "rhs");
   iterators(s.iterators, indent + 1);

@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "bodies/RigidBodies.h"
 #include "syntax/Parser.h"
 
 namespace qdot::driver {
@@ -66,6 +67,7 @@ const ast::ClassDef* LibraryLoader::find(const std::string& name) {
       }
       files_.push_back(syntax::parse(sources_, id, diags_));
       if (!files_.back()) return nullptr;
+      bodies::lowerRigidBodies(*files_.back(), sources_, diags_);
       for (const auto& c : files_.back()->classes)
         if (c->name == name) return c.get();
     }

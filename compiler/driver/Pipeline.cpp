@@ -9,6 +9,7 @@
 #include <iostream>
 #include <iterator>
 
+#include "bodies/RigidBodies.h"
 #include "bytecode/Emitter.h"
 #include "dae/IndexReduction.h"
 #include "syntax/Parser.h"
@@ -37,7 +38,11 @@ void reportMissingModel(Compilation& c, uint32_t file) {
 }
 
 bool parse(Compilation& c, uint32_t file) {
-  c.ast = timed(c.times.parse, [&] { return syntax::parse(c.sources, file, c.diags); });
+  c.ast = timed(c.times.parse, [&] {
+    auto tree = syntax::parse(c.sources, file, c.diags);
+    if (tree && !c.diags.hasErrors()) bodies::lowerRigidBodies(*tree, c.sources, c.diags);
+    return tree;
+  });
   return c.ast && !c.diags.hasErrors();
 }
 

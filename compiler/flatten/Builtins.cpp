@@ -50,6 +50,7 @@ Value Flattener::lowerCall(const CallExpr& e) {
     for (Expr& x : v.elems) x = timeDerivative(x, e.range);
     return v;
   }
+  if (auto call = m_.calls.find(&e); call != m_.calls.end()) return lowerFunctionCall(call->second);
   for (const auto& u : kUnaryMath)
     if (name == u.name) return mapUnary(arg(0), u.kind);
   if (name == "sqrt" || name == "log10") {
@@ -158,6 +159,7 @@ Value Flattener::lowerArrayBuiltin(const std::string& name, const CallExpr& e) {
     auto c = [&](int i, int j) { return ctx_.sub(ctx_.mul(a.elems[i], b.elems[j]), ctx_.mul(a.elems[j], b.elems[i])); };
     return Value{{3}, {c(1, 2), c(2, 0), c(0, 1)}};
   }
+  if (name == "eulerZXZ") return eulerZXZ(e);
   if (name == "size") {
     Value a = arg(0);
     if (e.args.size() == 2) {
@@ -171,6 +173,19 @@ Value Flattener::lowerArrayBuiltin(const std::string& name, const CallExpr& e) {
     return v;
   }
   fail(e.callee->range, DiagCode::E0210, "unknown function '" + name + "'");
+}
+
+// eulerZXZ(psi, theta, phi): the unit quaternion (scalar first) of the rotation Rz(psi) Rx(theta)
+// Rz(phi), the textbook's Euler angles (precession, nutation, spin), for a body's q(start = …).
+Value Flattener::eulerZXZ(const CallExpr& e) {
+  Expr psi = lowerScalar(*e.args[0], "psi of eulerZXZ()"), theta = lowerScalar(*e.args[1], "theta of eulerZXZ()"),
+       phi = lowerScalar(*e.args[2], "phi of eulerZXZ()");
+  Expr half = ctx_.constant(0.5);
+  Expr sum = ctx_.mul(half, ctx_.add(psi, phi)), diff = ctx_.mul(half, ctx_.sub(psi, phi)), t = ctx_.mul(half, theta);
+  Expr ct = ctx_.unary(Kind::Cos, t), st = ctx_.unary(Kind::Sin, t);
+  return Value{{4},
+               {ctx_.mul(ct, ctx_.unary(Kind::Cos, sum)), ctx_.mul(st, ctx_.unary(Kind::Cos, diff)),
+                ctx_.mul(st, ctx_.unary(Kind::Sin, diff)), ctx_.mul(ct, ctx_.unary(Kind::Sin, sum))}};
 }
 
 }  // namespace qdot::flat

@@ -76,10 +76,11 @@ Value Flattener::lower(const ast::Expr& e) {
 }
 
 Value Flattener::lowerName(const NameExpr& n) {
-  if (n.parts.size() > 1) return lowerDotted(n);
+  if (n.parts.size() > 1) return frames_.empty() ? lowerDotted(n) : lowerFunctionName(n);
   const std::string& name = n.parts[0];
   for (auto it = iterators_.rbegin(); it != iterators_.rend(); ++it)
     if (it->first == name) return Value::scalar(it->second);
+  if (!frames_.empty()) return lowerFunctionName(n);
   if (const sema::ModelSymbol* s = cur_->cls->find(name)) {
     if (s->kind == sema::SymbolKind::Component) fail(n.range, DiagCode::E0224, "'" + name + "' is a component, not a value");
     return valueOf(*cur_, *s, n.range);
@@ -135,7 +136,7 @@ std::vector<int> Flattener::subscriptIndices(const ast::Expr& s, int dimSize) {
 // The array being subscripted, without copying it when it is a declared name (x[i] in a loop
 // over a large array must not copy x each time).
 const Value& Flattener::subscriptBase(const ast::Expr& e, Value& holder) {
-  if (auto* n = dyn_cast<NameExpr>(&e); n && n->parts.size() == 1) {
+  if (auto* n = dyn_cast<NameExpr>(&e); n && n->parts.size() == 1 && frames_.empty()) {
     bool isIterator = false;
     for (const auto& it : iterators_) isIterator |= it.first == n->parts[0];
     const sema::ModelSymbol* s = cur_->cls->find(n->parts[0]);

@@ -83,10 +83,16 @@ struct Term {
   bool connectionFlow = false;  ///< a force: a connector's flow (spec §7), not a `force(q)` statement
 };
 
+/// How the runtime treats an output column between rows (`annotation(unwrap = …)`): an angle made
+/// continuous by multiples of 2π, or one of a z-x-z Euler-angle triple ψ, θ, φ (a rigid body's),
+/// made continuous together (θ changes sign where the body passes through θ = 0).
+enum class OutputKind : uint8_t { Plain, Angle, EulerPsi, EulerTheta, EulerPhi };
+
 struct Output {
   std::string name;
   sym::Expr value = nullptr;
   SourceRange range;
+  OutputKind kind = OutputKind::Plain;
 };
 
 struct Experiment {

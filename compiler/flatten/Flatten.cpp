@@ -226,6 +226,24 @@ static SymbolKind kindInInstance(SymbolKind kind, bool root, bool bound) {
   return kind;
 }
 
+// `annotation(unwrap = true)` on an output: an angle; `unwrap = "psi"|"theta"|"phi"`: one of a
+// z-x-z Euler-angle triple (written in that order). Anything else is an error at the value.
+OutputKind Flattener::outputKind(const Declaration& d) {
+  if (!d.annotation) return OutputKind::Plain;
+  for (const auto& m : d.annotation->mods) {
+    if (m.name != "unwrap" || !m.value) continue;
+    if (auto* b = dyn_cast<BoolExpr>(m.value.get())) return b->value ? OutputKind::Angle : OutputKind::Plain;
+    if (auto* s = dyn_cast<StringExpr>(m.value.get())) {
+      if (s->value == "psi") return OutputKind::EulerPsi;
+      if (s->value == "theta") return OutputKind::EulerTheta;
+      if (s->value == "phi") return OutputKind::EulerPhi;
+    }
+    fail(m.value->range, DiagCode::E0312, "unwrap takes true, false, \"psi\", \"theta\" or \"phi\"",
+         "annotation(unwrap = true) makes an angle output continuous (no jumps of 2 pi)");
+  }
+  return OutputKind::Plain;
+}
+
 Value Flattener::createDeclaration(const Declaration& d, const sema::ModelSymbol& s) {
   std::vector<int> shape = evaluateDims(d);
   bool root = cur_ == &instances_.front();
@@ -261,7 +279,8 @@ Value Flattener::createDeclaration(const Declaration& d, const sema::ModelSymbol
       Value v = bindingValue(d, shape);
       if (d.causality == Causality::Output) {
         std::vector<std::string> names = scalarNames(name, shape);
-        for (size_t i = 0; i < v.size(); ++i) out_.outputs.push_back({names[i], v.elems[i], d.nameRange});
+        OutputKind kind = outputKind(d);
+        for (size_t i = 0; i < v.size(); ++i) out_.outputs.push_back({names[i], v.elems[i], d.nameRange, kind});
       }
       return v;
     }

@@ -152,6 +152,7 @@ struct Connection {
 };
 
 class ValueKeys;  // Connections.cpp
+struct FunctionFrame;  // Functions.cpp
 
 /// An equation that makes variable x another variable (x = sign * y) or a known value (y < 0:
 /// x = value, an expression of parameters, and of time for a connector potential).
@@ -176,6 +177,8 @@ class Flattener {
   std::vector<sym::Expr> iterationValues(const ast::Expr& range);
   sym::Expr timeDerivative(sym::Expr e, SourceRange where);
   sym::Expr rateOf(sym::Expr symbol);
+  Value eulerZXZ(const ast::CallExpr& e);
+  OutputKind outputKind(const ast::Declaration& d);
 
   [[noreturn]] void fail(SourceRange r, DiagCode code, std::string msg, std::string help = {});
 
@@ -203,6 +206,7 @@ class Flattener {
   std::vector<size_t> aliasCandidates_;   ///< equations that may be aliases (`x = ±y`, `x = known`)
   std::vector<std::pair<std::string, sym::Expr>> iterators_;  ///< innermost last
   std::vector<std::pair<const Value*, int>> endContext_;      ///< (array, dimension) being subscripted, for `end`
+  std::vector<FunctionFrame*> frames_;  ///< function calls being inlined, innermost last
 
   // Flatten.cpp
   const Value& valueOf(Instance& inst, const sema::ModelSymbol& s, SourceRange use);
@@ -288,8 +292,15 @@ class Flattener {
   size_t elementOffset(const ast::IndexExpr& e, const Value& base);
   Value mapUnary(const Value& v, sym::Kind k);
 
+  // Functions.cpp
+  class FrameGuard;
+  Value lowerFunctionCall(const sema::FunctionCall& call);
+  Value functionVariable(const sema::ModelSymbol& s, SourceRange use);
+  Value lowerFunctionName(const ast::NameExpr& n);
+
   friend struct IteratorScope;
   friend class ScopeGuard;
+  friend class FrameGuard;
 };
 
 // Lowering in another instance's scope (a declaration resolved from anywhere, a modifier written

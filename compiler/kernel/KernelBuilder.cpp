@@ -50,6 +50,24 @@ class Builder {
     return static_cast<uint32_t>(m_.sources.size() - 1);
   }
 
+  // The ABI's output kinds: a z-x-z triple only where ψ, θ, φ are all kept, in order (pruning by
+  // --outputs may keep part of one: its ψ and φ are then unwrapped as single angles).
+  static std::vector<int32_t> outputKinds(const std::vector<flat::Output>& outputs) {
+    using K = flat::OutputKind;
+    std::vector<int32_t> kinds(outputs.size(), 0);
+    for (size_t i = 0; i < outputs.size(); ++i) {
+      K k = outputs[i].kind;
+      if (k == K::EulerPsi && i + 2 < outputs.size() && outputs[i + 1].kind == K::EulerTheta &&
+          outputs[i + 2].kind == K::EulerPhi) {
+        kinds[i] = 2;
+        i += 2;
+      } else if (k == K::Angle || k == K::EulerPsi || k == K::EulerPhi) {
+        kinds[i] = 1;
+      }
+    }
+    return kinds;
+  }
+
   void describeModel() {
     ModelDescription& d = m_.description;
     d.name = dae_.name;
@@ -63,6 +81,7 @@ class Builder {
       d.parameterDescriptions.push_back(p.description);
     }
     for (const auto& o : dae_.outputs) d.outputNames.push_back(o.name);
+    d.outputKinds = outputKinds(dae_.outputs);
     for (const auto& inv : dae_.invariants) d.invariantNames.push_back(inv.name);
     d.structuralParameters = dae_.structuralParameters;
     if (dae_.differentiatedRows.empty()) return;  // index ≤ 1: no dummy derivatives to choose

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <sstream>
 #include <unordered_set>
 
 #include "sema/ClassLookup.h"
@@ -20,6 +21,7 @@ const BuiltinFunction kBuiltins[] = {
     {"sign", 1, 1},     {"min", 1, 2},       {"max", 1, 2},   {"der", 1, 1},    {"sum", 1, 1},
     {"product", 1, 1},  {"fill", 2, -1},     {"zeros", 1, -1}, {"ones", 1, -1}, {"cross", 2, 2},
     {"dot", 2, 2},      {"transpose", 1, 1}, {"diagonal", 1, 1}, {"identity", 1, 1}, {"size", 1, 2},
+    {"eulerZXZ", 3, 3},
 };
 
 // Names that parse as calls but belong to events, which qdot does not compile.
@@ -50,6 +52,9 @@ class ModelChecker {
 
   /// The checked class, or null while it is being checked (a class that contains itself).
   const CheckedClass* check(const ClassDef& cls, bool root = false);
+  /// The checked function, or null while it is being checked (a function that calls itself).
+  const CheckedFunction* checkFunction(const ClassDef& cls);
+  void recordCall(const CallExpr& c, FunctionCall call) { out_.calls[&c] = std::move(call); }
   void checkFileImports(const std::vector<ImportClause>& imports);
   ClassLookup& lookup() { return lookup_; }
   DiagnosticEngine& diags() { return diags_; }
@@ -61,6 +66,7 @@ class ModelChecker {
   const Library& library_;
   CheckedModel& out_;
   std::unordered_map<const ClassDef*, const CheckedClass*> done_;
+  std::unordered_map<const ClassDef*, const CheckedFunction*> doneFunctions_;
   std::unordered_set<const ClassDef*> inProgress_;
 };
 
@@ -93,6 +99,30 @@ class ClassChecker {
     inMechanics_ = false;
   }
 
+  /// A function's variables: inputs (a binding is the default), one output and protected locals,
+  /// each bound to an expression of the function's own variables. No sections, no `extends`.
+  CheckedFunction runFunction() {
+    inFunction_ = true;
+    CheckedFunction f;
+    f.scope = &c_;
+    checkImports(c_.cls->imports);
+    for (const auto& e : c_.cls->extends)
+      functionError(e.range, "a function cannot extend a class", "write the function's inputs and output in it");
+    for (const auto& d : c_.cls->declarations) declareFunctionVariable(d, f);
+    for (const auto& d : c_.cls->declarations)
+      if (c_.symbols.at(d.name).decl == &d) checkDeclaration(d);
+    if (!f.output)
+      functionError(c_.cls->nameRange, "function '" + c_.fullName + "' has no output",
+                    "declare its result: output Real y = expression;");
+    const Equation* eq = !c_.cls->equations.empty() ? &c_.cls->equations[0]
+                         : !c_.cls->initialEquations.empty() ? &c_.cls->initialEquations[0] : nullptr;
+    if (eq) functionError(eq->range, "a function has no equations", "bind the output to an expression: output Real y = ...;");
+    if (!c_.cls->mechanics.empty())
+      functionError(c_.cls->mechanics[0].range, "a function has no mechanics section",
+                    "functions compute a value; energies belong in a model");
+    return f;
+  }
+
  private:
   ModelChecker& model_;
   CheckedClass& c_;
@@ -101,6 +131,7 @@ class ClassChecker {
   std::vector<std::string> iterators_;
   bool inMechanics_ = false;
   bool componentAllowed_ = false;  ///< inside connect(...): references may name connectors
+  bool inFunction_ = false;        ///< checking a function: only its own variables, no time, no der
   std::unordered_map<const ExtendsClause*, const CheckedClass*> bases_;
 
   // --- classes ---------------------------------------------------------------------------------
@@ -129,7 +160,10 @@ class ClassChecker {
   void inherit(const ExtendsClause& e) {
     if (builtinType(dottedName(e.baseName))) return;  // type Length = Real(unit = "m")
     const ClassDef* base = resolveClass(e.baseName, e.range);
-    if (!base) return;
+    if (base && base->kind == ClassKind::Function && c_.cls->kind != ClassKind::Function)
+      diags_.error(e.range, DiagCode::E0217, "'" + dottedName(e.baseName) + "' is a function; a class cannot extend it",
+                   "call it in an expression instead");
+    if (!base || base->kind == ClassKind::Function) return;
     const CheckedClass* b = checkedClass(*base, e.range, "extends " + dottedName(e.baseName));
     if (!b) return;
     bases_[&e] = b;
@@ -192,6 +226,11 @@ class ClassChecker {
       cls = nullptr;
     }
     s.type = builtin.value_or(BaseType::Real);
+    if (cls && cls->kind == ClassKind::Function) {
+      diags_.error(d.typeRange, DiagCode::E0217, "'" + t + "' is a function, not a model or connector",
+                   "call it in an expression: Real y = " + t + "(...);");
+      cls = nullptr;
+    }
     if (!builtin) {
       s.kind = SymbolKind::Component;
       if (cls) s.component = checkedClass(*cls, d.typeRange, "component '" + d.name + "'");
@@ -211,6 +250,48 @@ class ClassChecker {
     addSymbol(d, s);
   }
 
+  void functionError(SourceRange where, std::string msg, std::string help) {
+    diags_.error(where, DiagCode::E0214, std::move(msg), std::move(help));
+  }
+
+  // Scalar Real/Integer/Boolean; an input, the one output, or a protected local with a binding.
+  void declareFunctionVariable(const Declaration& d, CheckedFunction& f) {
+    ModelSymbol s;
+    s.decl = &d;
+    std::optional<BaseType> type = builtinType(dottedName(d.typeName));
+    const ClassDef* cls = type ? nullptr : model_.lookup().resolve(d.typeName, c_.cls);
+    if (cls && cls->kind == ClassKind::Type) type = BaseType::Real;  // type Length = Real(unit = "m")
+    s.type = type.value_or(BaseType::Real);
+    bool input = d.causality == Causality::Input && !d.isProtected;
+    s.kind = input ? SymbolKind::Input : SymbolKind::Definition;
+    if (!addSymbol(d, s)) return;
+    if (!type)
+      functionError(d.typeRange, "a function's variables are Real, Integer or Boolean, not '" + dottedName(d.typeName) + "'",
+                    "pass the values the function needs as Real inputs");
+    if (!d.dims.empty() || !d.typeDims.empty())
+      functionError(d.range, "array inputs, outputs and locals of functions are not supported",
+                    "declare scalars and call the function once per element: {f(x[i]) for i in 1:n}");
+    if (d.variability != Variability::Continuous || d.isFlow || d.isCoordinate)
+      functionError(d.range, "'" + d.name + "' of a function cannot be a parameter, constant, flow or coordinate",
+                    "remove the prefix: a function's variables are inputs, its output, or protected locals");
+    if (d.isProtected && d.causality != Causality::None)
+      functionError(d.range, "protected '" + d.name + "' cannot be an input or output", "move it before 'protected'");
+    else if (d.causality == Causality::None && !d.isProtected)
+      functionError(d.range, "'" + d.name + "' must be an 'input' or the 'output' of the function",
+                    "write 'input Real " + d.name + ";', or put local variables after 'protected'");
+    else if (!input && !d.binding)
+      functionError(d.nameRange, "'" + d.name + "' needs a value: a function is expression-bodied",
+                    "bind it to an expression of the inputs: " + std::string(d.isProtected ? "Real " : "output Real ") +
+                        d.name + " = ...;");
+    if (input) f.inputs.push_back(&d);
+    if (d.causality != Causality::Output || d.isProtected) return;
+    if (f.output)
+      functionError(d.nameRange, "a function has exactly one output; '" + f.output->name + "' is already its output",
+                    "make '" + d.name + "' a separate function, or a protected local");
+    else
+      f.output = &d;
+  }
+
   void checkDeclaration(const Declaration& d) {
     const ModelSymbol& s = c_.symbols.at(d.name);
     if (s.decl != &d) return;  // duplicate, already reported
@@ -219,7 +300,7 @@ class ClassChecker {
     if (s.kind == SymbolKind::Component) return checkComponentDeclaration(d, s);
     for (const auto& mod : d.mods) checkModification(d, mod);
     if (d.binding) checkExpr(*d.binding);
-    checkKindRules(d, s);
+    if (!inFunction_) checkKindRules(d, s);  // a function's variables have their own (declareFunctionVariable)
   }
 
   void checkComponentDeclaration(const Declaration& d, const ModelSymbol& s) {
@@ -488,6 +569,8 @@ class ClassChecker {
 
   void checkName(const NameExpr& n) {
     const std::string& first = n.parts[0];
+    if (n.parts.size() == 1 && first == "time" && inFunction_)
+      return functionError(n.range, "'time' is not available inside a function", "pass it as an argument: f(time)");
     if (n.parts.size() == 1 && (first == "time" || first == "pi")) return;
     if (n.parts.size() == 1 && std::find(iterators_.begin(), iterators_.end(), first) != iterators_.end()) return;
     const ModelSymbol* s = c_.find(first);
@@ -583,29 +666,136 @@ class ClassChecker {
       bool value;
       ~Restore() { flag = value; }
     } restore{componentAllowed_, allowed};
-    for (const auto& na : c.namedArgs)
-      diags_.error(na.nameRange, DiagCode::E0211, "named arguments are not allowed in a call to '" + name + "'",
-                   "pass the arguments by position");
     if (isEventFunction(name)) {
       diags_.error(c.callee->range, DiagCode::E0290, "'" + name + "' is not supported yet",
                    "events are not available: write the behaviour as an if-expression in an equation");
       return;
     }
+    if (inFunction_ && name == "der")
+      functionError(c.callee->range, "der() is not available inside a function",
+                    "pass the derivative as an argument: f(der(x))");
     const BuiltinFunction* f = findBuiltin(name);
-    if (!f) {
-      std::vector<std::string> names;
-      for (const auto& b : kBuiltins) names.push_back(b.name);
-      std::string guess = closestName(name, names);
-      diags_.error(c.callee->range, DiagCode::E0210, "unknown function '" + name + "'",
-                   guess.empty() ? "see docs/language.md for the built-in functions"
-                                 : "did you mean '" + guess + "'?");
-    } else {
+    if (!f) return checkFunctionCall(c);
+    for (const auto& na : c.namedArgs)
+      diags_.error(na.nameRange, DiagCode::E0211, "named arguments are not allowed in a call to '" + name + "'",
+                   "pass the arguments by position");
+    {
       int n = static_cast<int>(c.args.size());
       if (n < f->minArgs || (f->maxArgs >= 0 && n > f->maxArgs))
         diags_.error(c.range, DiagCode::E0212,
                      "'" + name + "' takes " + arityText(*f) + ", but " + std::to_string(n) + " given");
     }
     for (const auto& a : c.args) checkExpr(*a);
+  }
+
+  // A call of a user function: its class must be a function, not (through others) the one being
+  // checked; every argument binds one input.
+  void checkFunctionCall(const CallExpr& c) {
+    for (const auto& a : c.args) checkExpr(*a);
+    for (const auto& na : c.namedArgs) checkExpr(*na.value);
+    std::string name = c.callee->dotted();
+    const ClassDef* cls = model_.lookup().resolve(c.callee->parts, c_.cls);
+    if (!cls) return reportUnknownFunction(c);
+    if (cls->kind != ClassKind::Function) {
+      diags_.error(c.callee->range, DiagCode::E0217, "'" + name + "' is a class, not a function",
+                   "declare a component of it (" + name + " x(...);) and use its variables");
+      return;
+    }
+    const CheckedFunction* fn = model_.checkFunction(*cls);
+    if (!fn) {
+      diags_.error(c.callee->range, DiagCode::E0216, "'" + name + "' calls itself through this call",
+                   "a function is inlined where it is called, so it cannot call itself, directly or through others");
+      return;
+    }
+    bindArguments(c, *fn);
+  }
+
+  void reportUnknownFunction(const CallExpr& c) {
+    std::vector<std::string> names;
+    const auto& parts = c.callee->parts;
+    const ClassDef* owner =
+        parts.size() > 1 ? model_.lookup().resolve({parts.begin(), parts.end() - 1}, c_.cls) : nullptr;
+    std::string prefix = owner ? dottedName({parts.begin(), parts.end() - 1}) + "." : "";
+    if (owner)
+      for (const auto& n : owner->classes)
+        if (n->kind == ClassKind::Function) names.push_back(prefix + n->name);
+    if (!owner)
+      for (const auto& b : kBuiltins) names.push_back(b.name);
+    std::string guess = closestName(c.callee->dotted(), names);
+    diags_.error(c.callee->range, DiagCode::E0210, "unknown function '" + c.callee->dotted() + "'",
+                 !guess.empty() ? "did you mean '" + guess + "'?"
+                 : owner        ? "'" + dottedName({parts.begin(), parts.end() - 1}) + "' declares no such function"
+                                : "see docs/language.md for the built-in functions; a function of a package is "
+                                  "called by its full name (Fluid.gateForce) or after import Fluid.*;");
+  }
+
+  // Positional arguments bind the inputs in order, named ones by name; defaults fill the rest.
+  void bindArguments(const CallExpr& c, const CheckedFunction& fn) {
+    const std::string& name = fn.scope->fullName;
+    FunctionCall call{&fn, std::vector<const Expr*>(fn.inputs.size(), nullptr)};
+    bool ok = true;
+    if (c.args.size() > fn.inputs.size()) {
+      diags_.error(c.args[fn.inputs.size()]->range, DiagCode::E0212,
+                   "'" + name + "' takes " + inputsText(fn) + ", but " + std::to_string(c.args.size()) + " given",
+                   "its inputs: " + signatureText(fn));
+      ok = false;
+    }
+    for (size_t i = 0; i < c.args.size() && i < fn.inputs.size(); ++i) call.arguments[i] = c.args[i].get();
+    for (const auto& na : c.namedArgs) ok &= bindNamed(na, fn, call);
+    for (size_t i = 0; ok && i < fn.inputs.size(); ++i)
+      if (!call.arguments[i] && !fn.inputs[i]->binding) {
+        diags_.error(c.range, DiagCode::E0212, "missing argument '" + fn.inputs[i]->name + "' of '" + name + "'",
+                     "its inputs: " + signatureText(fn));
+        ok = false;
+      }
+    if (ok) model_.recordCall(c, std::move(call));
+  }
+
+  bool bindNamed(const NamedArg& na, const CheckedFunction& fn, FunctionCall& call) {
+    const std::string& name = fn.scope->fullName;
+    auto it = std::find_if(fn.inputs.begin(), fn.inputs.end(), [&](const Declaration* d) { return d->name == na.name; });
+    if (it == fn.inputs.end()) {
+      std::vector<std::string> names;
+      for (const Declaration* d : fn.inputs) names.push_back(d->name);
+      std::string guess = closestName(na.name, names);
+      diags_.error(na.nameRange, DiagCode::E0215, "'" + name + "' has no input '" + na.name + "'",
+                   guess.empty() ? "its inputs: " + signatureText(fn) : "did you mean '" + guess + "'?");
+      return false;
+    }
+    const Expr*& slot = call.arguments[it - fn.inputs.begin()];
+    if (slot) {
+      auto& d = diags_.error(na.nameRange, DiagCode::E0215, "input '" + na.name + "' of '" + name + "' is given twice",
+                             "give each input once, by position or by name");
+      d.notes.push_back({slot->range, "first given here"});
+      return false;
+    }
+    slot = na.value.get();
+    return true;
+  }
+
+  static std::string inputsText(const CheckedFunction& fn) {
+    size_t required = 0;
+    for (const Declaration* d : fn.inputs) required += d->binding ? 0 : 1;
+    auto plural = [](size_t k) { return std::to_string(k) + (k == 1 ? " argument" : " arguments"); };
+    if (required == fn.inputs.size()) return plural(required);
+    return std::to_string(required) + " to " + plural(fn.inputs.size());
+  }
+
+  // "width, depthTop, rho = 1000, g = …" (a default that is not a number shows as …)
+  static std::string signatureText(const CheckedFunction& fn) {
+    std::string s;
+    for (const Declaration* d : fn.inputs) {
+      s += (s.empty() ? "" : ", ") + d->name;
+      auto* number = d->binding ? dyn_cast<NumberExpr>(d->binding.get()) : nullptr;
+      if (d->binding) s += " = " + (number ? numberText(number->value) : std::string("…"));
+    }
+    return s.empty() ? "none" : s;
+  }
+
+  static std::string numberText(double v) {
+    std::ostringstream os;
+    os << v;
+    return os.str();
   }
 
   static std::string arityText(const BuiltinFunction& f) {
@@ -691,6 +881,20 @@ const ClassDef* findModel(const StoredDefinition& file, std::string_view name) {
 void ModelChecker::checkFileImports(const std::vector<ImportClause>& imports) {
   CheckedClass scratch;  // a class with no elements: only its imports are checked
   ClassChecker(*this, scratch, false).checkFileImports(imports);
+}
+
+const CheckedFunction* ModelChecker::checkFunction(const ClassDef& cls) {
+  if (auto it = doneFunctions_.find(&cls); it != doneFunctions_.end()) return it->second;
+  if (inProgress_.count(&cls)) return nullptr;
+  inProgress_.insert(&cls);
+  out_.classes.push_back(std::make_unique<CheckedClass>());
+  CheckedClass& c = *out_.classes.back();
+  c.cls = &cls;
+  c.fullName = lookup_.fullName(&cls);
+  out_.functions.push_back(std::make_unique<CheckedFunction>(ClassChecker(*this, c, false).runFunction()));
+  inProgress_.erase(&cls);
+  doneFunctions_.emplace(&cls, out_.functions.back().get());
+  return out_.functions.back().get();
 }
 
 const CheckedClass* ModelChecker::check(const ClassDef& cls, bool root) {

@@ -67,9 +67,26 @@ struct CheckedClass {
   }
 };
 
+/// A function: pure and expression-bodied (its output and protected locals are bound to
+/// expressions of its inputs), so flatten inlines each call symbolically.
+struct CheckedFunction {
+  const CheckedClass* scope = nullptr;          ///< its variables (inputs, output, locals) as a class
+  std::vector<const ast::Declaration*> inputs;  ///< in declaration order: the positional arguments
+  const ast::Declaration* output = nullptr;     ///< exactly one
+};
+
+/// One call of a function: per input, the argument written (by position or name), or null where
+/// the input's default applies.
+struct FunctionCall {
+  const CheckedFunction* function = nullptr;
+  std::vector<const ast::Expr*> arguments;
+};
+
 /// The model to compile and every class its components use.
 struct CheckedModel {
   std::vector<std::unique_ptr<CheckedClass>> classes;  ///< owns them all
+  std::vector<std::unique_ptr<CheckedFunction>> functions;
+  std::unordered_map<const ast::CallExpr*, FunctionCall> calls;  ///< every call of a function checked
   const CheckedClass* root = nullptr;                  ///< the model compiled
 };
 

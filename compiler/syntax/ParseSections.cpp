@@ -165,7 +165,7 @@ void Parser::parseMechanicsList(std::vector<ast::MechanicsStmt>& out) {
   while (true) {
     if (skipStrayEnd()) continue;
     bool statementWord = tok().isWord("kinetic") || tok().isWord("potential") || tok().isWord("dissipation") ||
-                         tok().isWord("force");  // `force q = 1;` is a broken statement, not a declaration
+                         tok().isWord("force") || tok().isWord("torque") || tok().isWord("gravity");  // `force q = 1;` is a broken statement, not a declaration
     if (!statementWord && atStatementListEnd(false)) break;
     uint64_t start = consumed_;
     if (auto s = parseMechanicsStmt()) out.push_back(std::move(*s));
@@ -174,17 +174,21 @@ void Parser::parseMechanicsList(std::vector<ast::MechanicsStmt>& out) {
 }
 
 /// mechanics_statement := ("kinetic" | "potential" | "dissipation") "=" expression ";"
-///                      | "force" "(" expression ")" "=" expression ";"
+///                      | "force" "(" expression ["," "at" "=" expression] ")" "=" expression ";"
+///                      | "torque" "(" expression ["," "world"] ")" "=" expression ";"
+///                      | "gravity" "=" expression ";"
 ///                      | "constraint" expression "=" expression ";"
 ///                      | "for" for_indices "loop" {mechanics_statement} "end" "for" ";"
 ///                      | annotation ";"
-/// (kinetic, potential, dissipation and force are contextual words; a description string may
+/// (kinetic, potential, dissipation, force, torque and gravity are contextual words; a description string may
 ///  precede each ';')
 std::optional<ast::MechanicsStmt> Parser::parseMechanicsStmt() {
   if (tok().isWord("kinetic")) return parseEnergyStmt(ast::MechanicsKind::Kinetic);
   if (tok().isWord("potential")) return parseEnergyStmt(ast::MechanicsKind::Potential);
   if (tok().isWord("dissipation")) return parseEnergyStmt(ast::MechanicsKind::Dissipation);
   if (tok().isWord("force")) return parseForceStmt();
+  if (tok().isWord("torque")) return parseForceStmt();
+  if (tok().isWord("gravity")) return parseEnergyStmt(ast::MechanicsKind::Gravity);
   if (at(TokenKind::kw_constraint)) return parseConstraintStmt();
   if (at(TokenKind::kw_for)) {
     DepthGuard guard(*this);
@@ -198,7 +202,8 @@ std::optional<ast::MechanicsStmt> Parser::parseMechanicsStmt() {
   }
   failExpected("a mechanics statement", DiagCode::E0124,
                "the mechanics section holds 'kinetic = e;', 'potential = e;', 'dissipation = e;', "
-               "'force(q) = e;', 'constraint lhs = rhs;' and for-loops; equations go in an 'equation' section");
+               "'force(q) = e;', 'constraint lhs = rhs;', for-loops and, for rigid bodies, 'gravity = {…};', "
+               "'torque(b) = {…};' and 'force(b, at = {…}) = {…};'; equations go in an 'equation' section");
   return std::nullopt;
 }
 
@@ -215,24 +220,53 @@ ast::MechanicsStmt Parser::parseEnergyStmt(ast::MechanicsKind kind) {
   return s;
 }
 
-/// force_statement := "force" "(" expression ")" "=" expression [description] ";"
+/// force_statement := "force" "(" expression ["," "at" "=" expression] ")" "=" expression [description] ";"
+///                  | "torque" "(" expression ["," "world"] ")" "=" expression [description] ";"
+/// (`at` and `world` only make sense for a rigid body; the body lowering checks that the target is one)
 ast::MechanicsStmt Parser::parseForceStmt() {
   Token kw = take();
+  bool torque = kw.text == "torque";
+  std::string word(kw.text);
   ast::MechanicsStmt s;
-  s.kind = ast::MechanicsKind::Force;
+  s.kind = torque ? ast::MechanicsKind::Torque : ast::MechanicsKind::Force;
   s.keywordRange = kw.range;
   if (!at(TokenKind::lParen)) {
-    failExpected("'(' after 'force'", DiagCode::E0117, "write force(q) = e; with the coordinate q in parentheses");
+    failExpected("'(' after '" + word + "'", DiagCode::E0117,
+                 torque ? "write torque(b) = {…}; with the body b in parentheses"
+                        : "write force(q) = e; with the coordinate q in parentheses");
   } else {
     OpTok open = takeOp();
     s.target = parseExpression();
+    if (!panic_ && accept(TokenKind::comma)) parseForceQualifier(s, torque);
     if (!panic_) expectClose(TokenKind::rParen, open);
-    if (!panic_ && expect(TokenKind::equal, "after 'force(...)'")) s.value = parseExpression();
+    if (!panic_ && expect(TokenKind::equal, "after '" + word + "(...)'")) s.value = parseExpression();
   }
   if (!panic_) parseDescription();
   s.range = rangeFrom(kw.range.begin);
-  if (!panic_) expectSemi("after the 'force' statement");
+  if (!panic_) expectSemi("after the '" + word + "' statement");
   return s;
+}
+
+/// What follows the target: `at = {…}` for a force on a body, `world` for a torque in world axes.
+void Parser::parseForceQualifier(ast::MechanicsStmt& s, bool torque) {
+  if (torque) {
+    if (tok().isWord("world")) {
+      take();
+      s.world = true;
+    } else {
+      failExpected("'world' after the body", DiagCode::E0116,
+                   "torque(b) = {…} is in body axes, torque(b, world) = {…} in world axes");
+    }
+    return;
+  }
+  if (tok().isWord("at") && peek(1).is(TokenKind::equal)) {
+    take();
+    take();
+    s.at = parseExpression();
+  } else {
+    failExpected("'at = {…}' after the body", DiagCode::E0116,
+                 "force(b, at = {x, y, z}) = {Fx, Fy, Fz}; applies a force in world axes at a point given in body axes");
+  }
 }
 
 /// constraint_statement := "constraint" expression "=" expression [description] ";"

@@ -40,7 +40,8 @@ bool isClassKeyword(TokenKind k) {
 }
 
 bool isMechanicsWord(const Token& t) {
-  return t.isWord("kinetic") || t.isWord("potential") || t.isWord("dissipation") || t.isWord("force");
+  return t.isWord("kinetic") || t.isWord("potential") || t.isWord("dissipation") || t.isWord("force") ||
+         t.isWord("torque") || t.isWord("gravity");
 }
 
 }  // namespace
@@ -140,6 +141,15 @@ bool Parser::atUnsupportedWord() {
   if (t.isWord("partial")) return isClassKeyword(next);
   if (!t.isWord("algorithm") && !t.isWord("protected") && !t.isWord("public")) return false;
   return next != TokenKind::equal && next != TokenKind::dot && next != TokenKind::lBracket && next != TokenKind::lParen;
+}
+
+/// visibility := "protected" | "public"   (only in a function: its protected declarations are its
+/// local variables, each bound to an expression; elsewhere E0119)
+bool Parser::parseVisibility() {
+  bool inFunction = currentClass_ && currentClass_->kind == ast::ClassKind::Function;
+  if (!inFunction || !atUnsupportedWord() || !(tok().isWord("protected") || tok().isWord("public"))) return false;
+  protected_ = take().isWord("protected");
+  return true;
 }
 
 /// Reports an unsupported Modelica word (E0119) and skips it; an `algorithm` section is skipped
@@ -386,12 +396,14 @@ std::unique_ptr<ast::ClassDef> Parser::parseClass() {
   } else {
     cls->description = parseDescription();
     ast::ClassDef* outer = currentClass_;
+    bool outerProtected = std::exchange(protected_, false);
     currentClass_ = cls.get();
     openClasses_.push_back(cls.get());
     parseComposition(*cls);
     parseClassEnd(*cls);
     openClasses_.pop_back();
     currentClass_ = outer;
+    protected_ = outerProtected;
   }
   cls->range = rangeFrom(kw.range.begin);
   return cls;
@@ -414,13 +426,17 @@ void Parser::parseShortClass(ast::ClassDef& cls) {
   expectSemi("after the definition of '" + cls.name + "'");
 }
 
-/// composition := {element} {section}
+/// composition := {element | visibility} {section}
 /// (elements after the first section are reported, E0125, and kept)
+/// A function is a class whose elements are `input` declarations (a binding is the default),
+/// one `output` declaration bound to the result, and `protected` locals bound in order:
+///   function f "description"  input Real x;  input Real k = 2;  output Real y = k*t;
+///                             protected Real t = x^2;  end f;
 void Parser::parseComposition(ast::ClassDef& cls) {
   SourceRange firstSection;
   while (!at(TokenKind::eof) && !at(TokenKind::kw_end)) {
     uint64_t start = consumed_;
-    if (skipUnsupported()) continue;
+    if (parseVisibility() || skipUnsupported()) continue;
     if (atSectionStart()) {
       if (!firstSection.valid()) firstSection = tok().range;
       parseSection(cls);
@@ -567,6 +583,7 @@ void Parser::parseComponentClause(ast::ClassDef& cls) {
     d.causality = pre.causality;
     d.isCoordinate = pre.isCoordinate;
     d.isFlow = pre.isFlow;
+    d.isProtected = protected_;
     d.typeName = type;
     d.typeRange = typeRange;
     for (const auto& e : typeDims) d.typeDims.push_back(e ? ast::clone(*e) : nullptr);

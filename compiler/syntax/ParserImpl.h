@@ -98,6 +98,7 @@ class Parser {
   bool atStatementListEnd(bool nested);
   bool atUnsupportedWord();
   bool skipUnsupported();
+  bool parseVisibility();
   bool atSyncPoint();
   /// From `begin` to the end of the last consumed token (never an inverted range).
   SourceRange rangeFrom(uint32_t begin) const { return {file_, begin, std::max(begin, prev_.range.end)}; }
@@ -151,6 +152,7 @@ class Parser {
   std::optional<ast::MechanicsStmt> parseMechanicsStmt();
   ast::MechanicsStmt parseEnergyStmt(ast::MechanicsKind kind);
   ast::MechanicsStmt parseForceStmt();
+  void parseForceQualifier(ast::MechanicsStmt& s, bool torque);
   ast::MechanicsStmt parseConstraintStmt();
   ast::MechanicsStmt parseMechanicsFor();
   std::vector<ast::Iterator> parseForIndices();
@@ -204,6 +206,7 @@ class Parser {
   std::vector<TokenKind> blockStack_;  ///< open for/if/when blocks, innermost last
   std::vector<TokenKind> brokenBlocks_;  ///< blocks abandoned after an error: their `end X;` comes later
   bool quietStrayEnds_ = false;          ///< after E0110, skipped blocks leave many `end X;` behind
+  bool protected_ = false;                ///< after `protected` in a function: declarations are locals
   ast::ClassDef* currentClass_ = nullptr;     ///< receives annotations and misplaced elements
   std::vector<const ast::ClassDef*> openClasses_;  ///< enclosing classes, outermost first
 };

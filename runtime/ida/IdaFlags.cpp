@@ -31,7 +31,8 @@ std::string idaReason(int flag, const FailureContext& c) {
     case IDA_TOO_MUCH_WORK:
       return fmt::format(
           "the solver took {} steps {} without reaching t = {:.10g}: the model may be very stiff or "
-          "oscillate fast, or a variable may grow without bound",
+          "oscillate fast (a lightly damped fast mode: try --solver arkode), a variable may grow without bound, or "
+          "its stiffnesses may lie more than about 1e15 apart, beyond double precision (model the stiff part as rigid)",
           c.maxSteps, where(c), c.tout);
     case IDA_TOO_MUCH_ACC:
       return fmt::format("the requested accuracy cannot be reached in double precision {}: increase --rtol/--atol",

@@ -85,7 +85,8 @@ struct IdaSession::Impl {
   SUNContext context = nullptr;
   void* ida = nullptr;
   N_Vector y = nullptr, yp = nullptr, id = nullptr, atol = nullptr;
-  N_Vector yStep = nullptr, ypStep = nullptr;  ///< after index reduction: the solution at IDA's last step
+  N_Vector yStep = nullptr, ypStep = nullptr;  ///< after index reduction or when observed: the solution at IDA's last step
+  IdaSession::StepObserver observer;
   double tStep = 0;
   SolverStats carried;  ///< counters of the integrations before the last restart (a new dummy choice)
   SUNMatrix matrix = nullptr;
@@ -306,7 +307,7 @@ void IdaSession::Impl::setup() {
 }
 
 void IdaSession::Impl::createVectors() {
-  if (dummies) {
+  if (dummies || options.observeSteps) {
     yStep = created(N_VNew_Serial(n, context), "N_VNew_Serial");
     ypStep = created(N_VNew_Serial(n, context), "N_VNew_Serial");
   }
@@ -349,11 +350,7 @@ void IdaSession::Impl::createIntegrator() {
 // itself uses the calibrated ones (Tolerances.h).
 void IdaSession::Impl::applyTolerances(bool calibrated) {
   tolerances = buildTolerances(options.rtol, options.atol, {data(y), n}, nominal, {model.isDifferential, n}, start);
-  if (!calibrated && tolerances.solverRtol < options.rtol) {  // undo the calibration (Tolerances.h)
-    double relaxed = options.rtol / tolerances.solverRtol;
-    for (double& a : tolerances.atol) a = options.atol ? a : a * relaxed;
-    tolerances.solverRtol = tolerances.summary.solverRtol = options.rtol;
-  }
+  if (!calibrated) useAsGiven(tolerances);
   std::copy(tolerances.atol.begin(), tolerances.atol.end(), data(atol));
   check(IDASVtolerances(ida, tolerances.solverRtol, atol), "IDASVtolerances");
 }
@@ -559,7 +556,7 @@ void IdaSession::Impl::initialize(double tout1) {
   // setup (which IDACalcIC has done), so new tolerances need a restart from the consistent point.
   check(IDAReInit(ida, options.t0, y, yp), "IDAReInit");
   applyTolerances();
-  if (dummies) {
+  if (yStep) {
     N_VScale(1.0, y, yStep);
     N_VScale(1.0, yp, ypStep);
     tStep = options.t0;
@@ -613,10 +610,11 @@ void IdaSession::Impl::useChoice(double time, N_Vector yv, N_Vector ypv) {
 // output at `target` is interpolated from the last step (IDAGetDky), which is never across a restart.
 double IdaSession::Impl::stepTo(double target) {
   while (tStep < target) {
-    if (chooseDummyDerivatives(tStep, yStep, ypStep, false)) useChoice(tStep, yStep, ypStep);
+    if (dummies && chooseDummyDerivatives(tStep, yStep, ypStep, false)) useChoice(tStep, yStep, ypStep);
     sunrealtype reached = tStep;
     check(IDASolve(ida, target, &reached, yStep, ypStep, IDA_ONE_STEP), "IDASolve");
     tStep = reached;
+    if (observer) observer(tStep, {N_VGetArrayPointer(yStep), n}, {N_VGetArrayPointer(ypStep), n});
   }
   check(IDAGetDky(ida, target, 0, y), "IDAGetDky");
   check(IDAGetDky(ida, target, 1, yp), "IDAGetDky");
@@ -629,7 +627,7 @@ double IdaSession::Impl::advanceTo(double target) {
   tout = target;
   if (n == 0) return t = target;
   clearFailure();
-  if (dummies) return stepTo(target);
+  if (dummies || options.observeSteps) return stepTo(target);
   sunrealtype reached = t;
   bool atStart = t == options.t0 && stats().steps == 0;
   std::vector<double> y0(atStart ? n : 0), yp0(atStart ? n : 0);
@@ -693,6 +691,7 @@ void IdaSession::setStopTime(double tstop) {
 }
 
 double IdaSession::advanceTo(double tout) { return impl_->advanceTo(tout); }
+void IdaSession::setStepObserver(StepObserver observer) { impl_->observer = std::move(observer); }
 double IdaSession::time() const { return impl_->t; }
 
 std::span<const double> IdaSession::y() const {

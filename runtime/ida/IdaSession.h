@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -38,6 +39,11 @@ struct SessionOptions {
   std::optional<double> atol;  ///< user's absolute tolerance (before scaling); default rtol
   LinearSolverKind linearSolver = LinearSolverKind::Auto;
   long maxStepsPerOutput = 100000;  ///< IDASetMaxNumSteps: steps allowed per advanceTo call
+  /// Integrate step by step (IDA_ONE_STEP, interpolating to each output time) so that a step
+  /// observer sees every internal step: angle outputs are unwrapped along the whole trajectory,
+  /// not only at output times that may not resolve a fast rotation.
+  bool observeSteps = false;
+  bool preserveInvariants = false;  ///< --preserve invariants (ArkodeSession only): project after each step
 };
 
 /// Counters read from IDA after (or during) a run.
@@ -86,6 +92,10 @@ class IdaSession {
   void setStopTime(double tstop);
   /// Integrates to tout (IDA_NORMAL, interpolated); returns the time reached.
   double advanceTo(double tout);
+  /// Called after every internal step when SessionOptions::observeSteps is set, with the step's
+  /// time, y and y' (the output rows are interpolated afterwards).
+  using StepObserver = std::function<void(double t, std::span<const double> y, std::span<const double> yp)>;
+  void setStepObserver(StepObserver observer);
 
   double time() const;                 ///< current time of y(), yp()
   std::span<const double> y() const;   ///< unknowns at time()

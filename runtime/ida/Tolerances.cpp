@@ -105,4 +105,13 @@ ToleranceVector buildTolerances(double rtol, std::optional<double> atol, std::sp
   return result;
 }
 
+void useAsGiven(ToleranceVector& t) {
+  ToleranceSummary& s = t.summary;
+  if (s.atolGiven || t.solverRtol >= s.rtol) return;
+  double relaxed = s.rtol / t.solverRtol;
+  for (double& a : t.atol) a *= relaxed;
+  s.atolMin *= relaxed, s.atolMedian *= relaxed, s.atolMax *= relaxed;
+  s.atolUser = t.solverRtol = s.solverRtol = s.rtol;
+}
+
 }  // namespace qdot::rt

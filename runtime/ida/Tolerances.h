@@ -67,4 +67,9 @@ ToleranceVector buildTolerances(double rtol, std::optional<double> atol, std::sp
                                 std::span<const double> nominal, std::span<const int32_t> isDifferential,
                                 std::span<const double> start = {});
 
+/// Undoes the calibration (no-op with --atol): solverRtol = rtol, automatic atol_i = rtol *
+/// scale_i, the summary to match. For IDACalcIC, a first step that fails at the calibrated
+/// tolerances, and ARKODE (the calibration is measured for IDA's BDF only).
+void useAsGiven(ToleranceVector& tolerances);
+
 }  // namespace qdot::rt

@@ -33,6 +33,15 @@ void addRunOptions(CLI::App& app, RunOptions& o) {
   app.add_flag("--invariants", o.invariants, "add the model's invariants (energy, momenta) as columns");
   app.add_option("--linear-solver", o.linearSolver, "dense, klu or auto (default auto)")
       ->check(CLI::IsMember({"auto", "dense", "klu"}));
+  // --solver (issue 11, section 3)
+  app.add_option("--solver", o.solver,
+                 "ida (BDF, any model; default), arkode (an L-stable ESDIRK method: models that are ODEs in their "
+                 "derivatives, e.g. stiff oscillations) or auto (chosen from the linearization at the start)")
+      ->check(CLI::IsMember({"ida", "arkode", "auto"}));
+  app.add_option("--preserve", o.preserve,
+                 "invariants: after every step, project the state onto the start values of the model's invariants "
+                 "(energy, momenta); needs --solver arkode")
+      ->check(CLI::IsMember({"invariants"}));
   app.add_option("--csv-names", o.csvNames,
                  "CSV header: modelica (der(x), x[1]; default) or identifier (der_x, x_1: for numpy and other "
                  "tools that take identifiers only)")
@@ -85,6 +94,16 @@ void checkTolerances(double rtol, std::optional<double> atol) {
     requireFinite("--atol", *atol);
     if (*atol <= 0) throw UsageError(fmt::format("--atol must be positive (got {})", *atol));
   }
+}
+
+// issue 11, section 5: below a few ulps no integrator can deliver the relative accuracy asked for
+// (each step's rounding alone is larger), so the request is refused before anything runs.
+void checkRoundOffFloor(double rtol) {
+  if (rtol >= kRoundOffFloor) return;
+  throw UsageError(fmt::format("--rtol {:g} is below the round-off floor of double precision ({:.2g} = 10 × machine "
+                               "epsilon): every step's rounding is larger than that, so no solver can deliver it; use "
+                               "--rtol 1e-14 or larger (1e-10 already gives a tight reference solution)",
+                               rtol, kRoundOffFloor));
 }
 
 void checkTimes(double start, double stop, double interval) {
@@ -156,10 +175,25 @@ ResolvedRun resolveRunOptions(const RunOptions& o, const ExperimentDefaults& e, 
   s.rtol = o.rtol.value_or(e.tolerance.value_or(kDefaultRtol));
   s.atol = o.atol;
   checkTolerances(s.rtol, s.atol);
+  checkRoundOffFloor(s.rtol);
   auto solver = parseLinearSolver(o.linearSolver);
   if (!solver) throw UsageError(fmt::format("--linear-solver must be dense, klu or auto (got '{}')", o.linearSolver));
   s.linearSolver = *solver;
   s.invariants = o.invariants;
+  // --solver (issue 11, section 3)
+  auto integrator = parseSolver(o.solver);
+  if (!integrator) throw UsageError(fmt::format("--solver must be ida, arkode or auto (got '{}')", o.solver));
+  s.solver = *integrator;
+  if (!o.preserve.empty() && o.preserve != "invariants")
+    throw UsageError(fmt::format("--preserve must be invariants (got '{}')", o.preserve));
+  s.preserveInvariants = o.preserve == "invariants";
+  if (s.preserveInvariants && s.solver != SolverKind::Arkode)
+    throw UsageError("--preserve invariants needs --solver arkode: the projection changes the state after every "
+                     "step, which a one-step method takes in its stride but which would invalidate IDA's multistep "
+                     "history");
+  if (s.preserveInvariants && model.nInvariants == 0)
+    throw UsageError("--preserve invariants: the model has no invariants (no energy or momentum is conserved: it is "
+                     "damped, forced or driven)");
   if (!o.outputs.empty()) s.columns = selectColumns(model, o.outputs, o.invariants);
   s.parameters = evaluateParameters(model, parameterOverrides(model, o.parameters));
   run.outputPath = o.outputPath;

@@ -34,6 +34,9 @@ struct RunOptions {
   std::optional<long> maxSteps;  ///< --max-steps N: solver steps allowed over the whole run
   bool force = false;            ///< --force: write more than kMaxRowsWithoutForce rows
   bool progress = true;          ///< false with --no-progress; shown only on a terminal, see Run.h
+  // --solver (issue 11, section 3)
+  std::string solver = "ida";  ///< --solver ida|arkode|auto
+  std::string preserve;        ///< --preserve invariants (issue 11, section 4); "" = none
 };
 
 /// The model's experiment annotation, as far as it gives values.
@@ -47,6 +50,8 @@ inline constexpr double kDefaultRtol = 1e-6;
 /// More output rows than this (a CSV of about a gigabyte) need --force: an --interval typed with a
 /// wrong exponent is refused before it fills the disk.
 inline constexpr double kMaxRowsWithoutForce = 1e7;
+/// The smallest --rtol accepted: 10 × DBL_EPSILON (issue 11, section 5).
+inline constexpr double kRoundOffFloor = 10 * 2.220446049250313e-16;
 
 /// Adds --start --stop --interval --rtol --atol -p --outputs -o --stats --invariants
 /// --linear-solver --csv-names --max-steps --force --no-progress to app, storing into options (which must outlive the parse).

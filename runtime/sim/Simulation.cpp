@@ -13,7 +13,9 @@
 #include <memory>
 #include <set>
 
+#include "arkode/ArkodeSession.h"
 #include "ida/ModelCheck.h"
+#include "output/AngleUnwrap.h"
 #include "sim/Names.h"
 
 namespace qdot::rt {
@@ -33,7 +35,8 @@ void appendColumns(std::vector<Column>& columns, Column::Source source, const ch
 class RowBuilder {
  public:
   RowBuilder(const QdotModel& model, const std::vector<Column>& columns, std::span<const double> p)
-      : model_(model), columns_(columns), p_(p), values_(columns.size()) {
+      : model_(model), columns_(columns), p_(p), values_(columns.size()),
+        unwrap_(model.outputKinds ? std::span<const int32_t>(model.outputKinds, model.nOutputs) : std::span<const int32_t>()) {
     for (const Column& c : columns) {
       needOutputs_ |= c.source == Column::Source::Output;
       needInvariants_ |= c.source == Column::Source::Invariant;
@@ -42,8 +45,20 @@ class RowBuilder {
     invariants_.resize(model.nInvariants);
   }
 
+  /// Whether outputs are unwrapped (then every solver step should be observed).
+  bool unwraps() const { return needOutputs_ && unwrap_.active(); }
+
+  /// Follows the angle outputs through one solver step (no row is written).
+  void observe(double t, std::span<const double> y, std::span<const double> yp) {
+    evaluate(model_.outputs, "outputs", t, y, yp, outputs_);
+    unwrap_.apply(outputs_);
+  }
+
   std::span<const double> build(double t, std::span<const double> y, std::span<const double> yp) {
-    if (needOutputs_) evaluate(model_.outputs, "outputs", t, y, yp, outputs_);
+    if (needOutputs_) {
+      evaluate(model_.outputs, "outputs", t, y, yp, outputs_);
+      unwrap_.apply(outputs_);
+    }
     if (needInvariants_) evaluate(model_.invariants, "invariants", t, y, yp, invariants_);
     for (std::size_t i = 0; i < columns_.size(); ++i)
       values_[i] = value(columns_[i], y);
@@ -76,6 +91,7 @@ class RowBuilder {
   const std::vector<Column>& columns_;
   std::span<const double> p_;
   std::vector<double> values_, outputs_, invariants_;
+  AngleUnwrapper unwrap_;  ///< angle outputs continuous from row to row
   bool needOutputs_ = false, needInvariants_ = false;
 };
 
@@ -107,7 +123,8 @@ class ProgressLine {
 
 /// --max-steps: IDA counts steps per call (IDASetMaxNumSteps), so the limit over the run is
 /// checked after every output time, and IDA's own limit per call is lowered to it.
-void checkStepLimit(const SimulationSettings& s, const IdaSession& session) {
+template <class Session>
+void checkStepLimit(const SimulationSettings& s, const Session& session) {
   if (!s.maxSteps) return;
   long steps = session.stats().steps;
   if (steps >= *s.maxSteps && session.time() < s.stop)
@@ -123,12 +140,14 @@ SessionOptions sessionOptions(const SimulationSettings& s) {
   o.atol = s.atol;
   o.linearSolver = s.linearSolver;
   o.maxStepsPerOutput = s.maxSteps ? std::min(s.maxStepsPerOutput, *s.maxSteps) : s.maxStepsPerOutput;
+  o.preserveInvariants = s.preserveInvariants;
   return o;
 }
 
 /// advanceTo; a failure caused by the --max-steps limit (IDA_TOO_MUCH_WORK within one interval)
-/// is reported as that limit, not as IDA's generic message.
-double advanceWithin(const SimulationSettings& s, IdaSession& session, double tout) {
+/// is reported as that limit, not as the solver's generic message.
+template <class Session>
+double advanceWithin(const SimulationSettings& s, Session& session, double tout) {
   try {
     return session.advanceTo(tout);
   } catch (const IdaError&) {
@@ -137,7 +156,8 @@ double advanceWithin(const SimulationSettings& s, IdaSession& session, double to
   }
 }
 
-void collect(SimulationResult& r, const IdaSession& session) {
+template <class Session>
+void collect(SimulationResult& r, const Session& session) {
   r.tolerances = session.tolerances();
   r.linearSolver = session.linearSolver();
   r.computedInitialValues = session.computedInitialValues();
@@ -198,16 +218,18 @@ double OutputGrid::operator[](std::size_t k) const {
   return std::strtod(text, nullptr);
 }
 
-SimulationResult simulate(const QdotModel& model, const SimulationSettings& settings, ResultSink& sink) {
-  SimulationResult result;
-  result.failureTime = settings.start;
-  result.linearSolverChosenAutomatically = settings.linearSolver == LinearSolverKind::Auto;
+namespace {
+
+// The loop over the output grid with either integrator (IdaSession or ArkodeSession: the same face).
+template <class Session>
+SimulationResult simulateWith(const QdotModel& model, const SimulationSettings& settings, ResultSink& sink,
+                              SimulationResult result) {
   std::vector<Column> columns =
       settings.columns.empty() ? defaultColumns(model, settings.invariants) : settings.columns;
   std::vector<std::string> names;
   for (const Column& c : columns)
     names.push_back(c.name);
-  std::unique_ptr<IdaSession> session;
+  std::unique_ptr<Session> session;
   Clock::time_point clock = Clock::now();
   bool solving = false;
   try {
@@ -217,13 +239,21 @@ SimulationResult simulate(const QdotModel& model, const SimulationSettings& sett
                      settings.start);
     OutputGrid grid(settings.start, settings.stop, settings.interval);
     sink.begin(names);  // the header is written even if the setup fails
-    session = std::make_unique<IdaSession>(model, settings.parameters, sessionOptions(settings));
+    SessionOptions options = sessionOptions(settings);
+    RowBuilder rows(model, columns, settings.parameters);
+    // Angle outputs follow every internal step where the session can show them (IDA); ARKODE's
+    // rows alone are unwrapped (an output interval must then resolve the rotation).
+    constexpr bool observable = requires(Session& s) { s.setStepObserver({}); };
+    options.observeSteps = observable && rows.unwraps();
+    session = std::make_unique<Session>(model, settings.parameters, options);
+    if constexpr (observable)
+      if (rows.unwraps())
+        session->setStepObserver([&rows](double t, std::span<const double> y, std::span<const double> yp) { rows.observe(t, y, yp); });
     session->initialize(grid[1]);
     session->setStopTime(settings.stop);
     result.setupSeconds = secondsSince(clock);
     clock = Clock::now();
     solving = true;
-    RowBuilder rows(model, columns, session->parameters());
     ProgressLine progress(settings.progress, settings.start, settings.stop);
     for (std::size_t k = 0; k < grid.size(); ++k) {
       double t = k == 0 ? session->time() : advanceWithin(settings, *session, grid[k]);
@@ -248,8 +278,26 @@ SimulationResult simulate(const QdotModel& model, const SimulationSettings& sett
     if (result.success) result.message = e.what();
     result.success = false;
   }
+  std::vector<std::string> notes = std::move(result.warnings);
   if (session) collect(result, *session);
+  result.warnings.insert(result.warnings.begin(), notes.begin(), notes.end());
   return result;
+}
+
+}  // namespace
+
+SimulationResult simulate(const QdotModel& model, const SimulationSettings& settings, ResultSink& sink) {
+  SimulationResult result;
+  result.failureTime = settings.start;
+  result.linearSolverChosenAutomatically = settings.linearSolver == LinearSolverKind::Auto;
+  result.solver = settings.solver;
+  if (settings.solver == SolverKind::Auto) {
+    SolverChoice choice = chooseSolver(model, settings.parameters, settings.start, settings.stop);
+    result.solver = choice.kind;
+    result.warnings.push_back("note: --solver auto " + choice.reason);
+  }
+  if (result.solver == SolverKind::Arkode) return simulateWith<ArkodeSession>(model, settings, sink, std::move(result));
+  return simulateWith<IdaSession>(model, settings, sink, std::move(result));
 }
 
 }  // namespace qdot::rt

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "arkode/SolverChoice.h"
 #include "ida/IdaSession.h"
 #include "output/ResultSink.h"
 #include "qdot/model_abi.h"
@@ -59,6 +60,9 @@ struct SimulationSettings {
   long maxStepsPerOutput = 100000;
   std::optional<long> maxSteps;        ///< steps allowed over the whole run (--max-steps); none = no limit
   std::ostream* progress = nullptr;    ///< a terminal: progress once the run is longer than kProgressAfter
+  // --solver (issue 11, section 3): which integrator; Auto picks from the linearization at the start.
+  SolverKind solver = SolverKind::Ida;
+  bool preserveInvariants = false;  ///< --preserve invariants: project onto their start values (arkode)
 };
 
 /// Seconds of solving after which progress is shown (when SimulationSettings::progress is set).
@@ -77,6 +81,7 @@ struct SimulationResult {
   bool linearSolverChosenAutomatically = false;            ///< --linear-solver auto
   bool computedInitialValues = false;
   std::vector<std::string> warnings;
+  SolverKind solver = SolverKind::Ida;  ///< the integrator that ran (never Auto)
   double setupSeconds = 0;  ///< wall time: session setup and consistent initial values
   double solveSeconds = 0;  ///< wall time: integration and writing
 };

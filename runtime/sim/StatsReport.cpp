@@ -3,6 +3,8 @@
 
 #include <fmt/format.h>
 
+#include "arkode/ArkodeSession.h"
+
 namespace qdot::rt {
 namespace {
 
@@ -26,10 +28,12 @@ std::string toleranceText(const ToleranceSummary& t) {
 std::string formatStats(const SimulationResult& r) {
   const SolverStats& s = r.stats;
   std::string out = "statistics:\n";
+  bool arkode = r.solver == SolverKind::Arkode;  // --solver arkode: y' = g(t, y), one residual and two Jacobian calls each
+  if (arkode) line(out, "integrator", fmt::format("arkode, {}", kArkodeMethodName));
   line(out, "steps", fmt::format("{} (last step {:.3g}, order {})", s.steps, s.lastStep, s.lastOrder));
-  line(out, "residual evaluations", fmt::format("{}", s.residualEvaluations));
+  line(out, arkode ? "right-hand side evals" : "residual evaluations", fmt::format("{}", s.residualEvaluations));
   line(out, "Jacobian evaluations", fmt::format("{}", s.jacobianEvaluations));
-  line(out, "nonlinear iterations", fmt::format("{}", s.nonlinearIterations));
+  line(out, arkode ? "linear solves" : "nonlinear iterations", fmt::format("{}", s.nonlinearIterations));
   line(out, "error-test failures", fmt::format("{}", s.errorTestFailures));
   line(out, "convergence failures", fmt::format("{}", s.convergenceFailures));
   line(out, "linear solver",
@@ -42,7 +46,9 @@ std::string formatStats(const SimulationResult& r) {
   if (s.initialNewtonIterations >= 0)
     line(out, "initial values", fmt::format("initialization system solved ({} Newton iterations)", s.initialNewtonIterations));
   else
-    line(out, "initial values", r.computedInitialValues ? "made consistent by IDACalcIC" : "consistent as given");
+    line(out, "initial values", r.computedInitialValues ? "made consistent by IDACalcIC"
+                                : arkode           ? "consistent as given (y' = g(t0, y0))"
+                                                   : "consistent as given");
   line(out, "tolerances", toleranceText(r.tolerances));
   line(out, "rows written", fmt::format("{}", r.rows));
   line(out, "wall time", fmt::format("setup {:.3f} s, solve {:.3f} s", r.setupSeconds, r.solveSeconds));

@@ -114,7 +114,7 @@ void writeDescription(Writer& w, const ModelDescription& d) {
                             &d.invariantNames, &d.structuralParameters})
     w.strings(*names);
   for (const auto* ints : {&d.isDifferential, &d.fixed, &d.jacobianColumnStarts, &d.jacobianRowIndices,
-                           &d.derivativeLinks, &d.differentiatedRowStarts, &d.differentiatedRows, &d.initialRows})
+                           &d.derivativeLinks, &d.differentiatedRowStarts, &d.differentiatedRows, &d.initialRows, &d.outputKinds})
     w.words(*ints);
   w.strings(d.initialRowLabels);
 }
@@ -126,7 +126,7 @@ ModelDescription readDescription(Reader& r) {
                       &d.invariantNames, &d.structuralParameters})
     *names = r.strings();
   for (auto* ints : {&d.isDifferential, &d.fixed, &d.jacobianColumnStarts, &d.jacobianRowIndices,
-                     &d.derivativeLinks, &d.differentiatedRowStarts, &d.differentiatedRows, &d.initialRows})
+                     &d.derivativeLinks, &d.differentiatedRowStarts, &d.differentiatedRows, &d.initialRows, &d.outputKinds})
     *ints = r.words<int32_t>();
   d.initialRowLabels = r.strings();
   return d;

@@ -4,6 +4,7 @@
 // step-size collapse).
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <regex>
 
 #include "QdotRun.h"
@@ -332,6 +333,59 @@ TEST(FluidLibrary, FloatingBoxHeaveFrequency) {
   const double measured = (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
   EXPECT_NEAR(measured, period, 1e-5 * period);
   std::cout << "[measured] heave period " << measured << " s (2π/ω = " << period << " s)\n";
+}
+
+// ---------------------------------------------------------------------------------------------
+// gate.qd: the hydrostatics functions of Fluid on a gate (w = 1.5 m, edges 1.2 m and 0.2 m above the
+// floor) in a tank (2 m²) filled at 0.01 m³/s from h = 2 m: h = 2 + 0.005 t exactly (a constant
+// rate, which BDF integrates to rounding: within 1e-12 m, measured 4e-16). The oracles are the textbook's forms, not
+// the library's: with the edges at depths d1 = h − 1.2, d2 = h − 0.2, the gate's height b = d2 − d1
+// and its centroid's depth ȳ = (d1 + d2)/2,
+//   F = rho g ȳ (w b)   (the pressure at the centroid times the area; = rho g w (d2² − d1²)/2),
+//   y_cp = ȳ + I/(ȳ A) = ȳ + b²/(12 ȳ)   (= (2/3)(d2³ − d1³)/(d2² − d1²)),
+// the latch's force F (y_cp − d1)/b, the floor's pressure p0 + rho g h and the sea-water force with
+// rho = 1025 (a named argument). The functions' values are exact expressions of h: relative 1e-12
+// covers the propagated 1e-12 m of h and rounding (measured below 2e-15).
+TEST(FluidLibrary, GateForceAndCentreOfPressureFromTheFunctions) {
+  auto r = runExample("gate");
+  expectGrid(r, 0, 100, 1);
+  const double rho = 1000, g = 9.81, w = 1.5, zTop = 1.2, zBottom = 0.2, b = zTop - zBottom;
+  auto h = [](double t) { return 2 + 0.005 * t; };
+  auto centroid = [&](double t) { return h(t) - (zTop + zBottom) / 2; };
+  auto force = [&](double t, double density) { return density * g * centroid(t) * w * b; };
+  auto ycp = [&](double t) { return centroid(t) + b * b / (12 * centroid(t)); };
+  auto relative = [](const std::function<double(double)>& f) { return [f](double t) { return 1e-12 * std::fabs(f(t)); }; };
+  compareColumn(r, "h", h, [](double) { return 1e-12; });
+  std::function<double(double)> F = [&](double t) { return force(t, rho); };
+  std::function<double(double)> FSea = [&](double t) { return force(t, 1025); };
+  std::function<double(double)> Y = ycp;
+  std::function<double(double)> latch = [&](double t) { return F(t) * (ycp(t) - (h(t) - zTop)) / b; };
+  std::function<double(double)> pFloor = [&](double t) { return 101325 + rho * g * h(t); };
+  compareColumn(r, "F", F, relative(F));
+  compareColumn(r, "FSea", FSea, relative(FSea));
+  compareColumn(r, "ycp", Y, relative(Y));
+  compareColumn(r, "latch", latch, relative(latch));
+  compareColumn(r, "pFloor", pFloor, relative(pFloor));
+}
+
+// buoy.qd: a buoy (m = 200 kg, Aw = 0.5 m², H = 1 m) whose only force besides gravity is
+// Fluid.buoyancy(Aw d), released at d = 0.5 m from rest: d = d_eq + a cos ωt, d_eq = m/(rho Aw) =
+// 0.4 m, a = 0.1 m, ω = √(rho g Aw/m), under oscillationBound with the error scale of d (its largest
+// value, 0.5 m: the tolerance is relative to d); the buoyancy column equals rho g Aw d of the same
+// row (the inlined function, relative 1e-12) and stays in (0, rho g Aw H) (the box stays afloat).
+TEST(FluidLibrary, BuoyHeavesOnArchimedesForce) {
+  auto r = runExample("buoy");
+  expectGrid(r, 0, 5, 0.01);
+  const double rho = 1000, g = 9.81, m = 200, Aw = 0.5, dEq = m / (rho * Aw), a = 0.1, w = std::sqrt(rho * g * Aw / m);
+  const double period = 2 * M_PI / w;
+  compareColumn(r, "d", [&](double t) { return dEq + a * std::cos(w * t); },
+                [&](double t) { return oscillationBound(kRtol, dEq + a, period, t); });
+  const auto &d = r.col("d"), &Fb = r.col("Fb");
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    EXPECT_NEAR(Fb[i], rho * g * Aw * d[i], 1e-12 * rho * g * Aw) << "row " << i;
+    EXPECT_GT(Fb[i], 0);
+    EXPECT_LT(Fb[i], rho * g * Aw * 1.0);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------

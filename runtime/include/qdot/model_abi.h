@@ -17,7 +17,7 @@
 extern "C" {
 #endif
 
-#define QDOT_MODEL_ABI_VERSION 2
+#define QDOT_MODEL_ABI_VERSION 3
 
 typedef struct QdotModel QdotModel;
 
@@ -60,6 +60,10 @@ struct QdotModel {
    * The runtime solves them with the other rows at the start and leaves them out afterwards. */
   uint32_t nInitialRows;
   const char* const* initialRowLabels;     /* [nInitialRows], e.g. "initial equation x + der(x) = 3" */
+  /* How the runtime makes outputs continuous from one result row to the next: 0 as computed,
+   * 1 an angle (plus the multiple of 2 pi nearest the previous row's), 2 the first of a z-x-z
+   * Euler-angle triple psi, theta, phi in consecutive outputs (see runtime/output/AngleUnwrap.h). */
+  const int32_t* outputKinds;              /* [nOutputs] */
 
   /* --- functions ---------------------------------------------------------------------------- */
   /* Parameter values: p[i] = overridden[i] ? given[i] : default binding of parameter i, evaluated

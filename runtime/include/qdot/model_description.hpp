@@ -22,6 +22,7 @@ struct ModelDescription {
   std::vector<std::string> parameterNames;         ///< [nParameters]
   std::vector<std::string> parameterDescriptions;  ///< [nParameters], "" if none
   std::vector<std::string> outputNames, invariantNames;
+  std::vector<int32_t> outputKinds;  ///< [nOutputs]: 0 plain, 1 angle, 2 first of a z-x-z triple (model_abi.h)
   std::vector<int32_t> isDifferential;  ///< [nVariables]: 1 if y' of the variable appears
   std::vector<int32_t> fixed;           ///< [nVariables]: start value fixed during initialisation (kFixed…)
   std::vector<int32_t> jacobianColumnStarts, jacobianRowIndices;  ///< CSC, column j = variable j
@@ -93,6 +94,10 @@ struct ModelDescription {
       if (starts[k + 1] - starts[k] < 2) return "a differentiated equation has fewer than two rows";
     size_t rowsEnd = residualCount();
     if (initialRowLabels.size() != initialRows.size()) return "initial rows and their labels differ in number";
+    if (outputKinds.size() != outputNames.size()) return "output kinds and output names differ in number";
+    for (size_t k = 0; k < outputKinds.size(); ++k)
+      if (outputKinds[k] < 0 || outputKinds[k] > 2 || (outputKinds[k] == 2 && k + 2 >= outputKinds.size()))
+        return "an output kind is out of range";
     for (size_t k = 0; k < initialRows.size(); ++k)
       if (static_cast<size_t>(initialRows[k]) != residualCount() - initialRows.size() + k)
         return "the initial rows are not the last rows";

@@ -49,6 +49,7 @@ inline void fillModelTable(QdotModel& m, ModelNameTable& names, const ModelDescr
   m.differentiatedRows = d.differentiatedRows.data();
   m.nInitialRows = static_cast<uint32_t>(d.initialRows.size());
   m.initialRowLabels = names.initialRows.data();
+  m.outputKinds = d.outputKinds.data();
 }
 
 }  // namespace qdot
