@@ -13,6 +13,7 @@
 #include <functional>
 #include <map>
 
+#include "arkode/SolverChoice.h"
 #include "driver/Backends.h"
 #include "driver/WorkPrecisionExact.h"
 #include "driver/WorkPrecisionReference.h"
@@ -35,8 +36,7 @@ struct Configuration {
   std::string label() const { return backend + "/" + solver; }
 };
 
-/// Every backend × every solver, in the order given. (A --solver axis is this second loop: the
-/// runs themselves take the solver from Configuration::solver once `qdot run` has --solver.)
+/// Every backend × every solver, in the order given.
 std::vector<Configuration> configurations(const WorkPrecisionOptions& o) {
   std::vector<std::string> backends = o.backends.empty() ? std::vector<std::string>{"llvm"} : o.backends;
   std::vector<std::string> solvers = o.solvers.empty() ? std::vector<std::string>{"ida"} : o.solvers;
@@ -251,7 +251,9 @@ void addWorkPrecisionOptions(CLI::App& cmd, WorkPrecisionOptions& o) {
   cmd.add_option("--backend", o.backends, "backends to compare, comma-separated: llvm (default), bytecode")
       ->delimiter(',')
       ->check(CLI::IsMember({"llvm", "bytecode"}));
-  cmd.add_option("--solver", o.solvers, "solvers to compare (today: ida)")->delimiter(',')->check(CLI::IsMember({"ida"}));
+  cmd.add_option("--solver", o.solvers, "solvers to compare, comma-separated: ida (default), arkode, auto")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"ida", "arkode", "auto"}));
   cmd.add_option("-o,--output", o.outputPrefix,
                  "write PREFIX.csv and PREFIX.svg (default: next to the model, MODEL.wp.csv and MODEL.wp.svg)");
   cmd.add_option("--csv", o.csvPath, "write the table as CSV to this file (overrides -o)");
@@ -302,8 +304,10 @@ ExitCode workPrecision(Compilation& c, const std::string& modelPath, const WorkP
     series.label = config.label();
     series.backend = config.backend;
     series.solver = config.solver;
+    rt::SimulationSettings configured = *settings;
+    configured.solver = *rt::parseSolver(config.solver);  // checked by the option
     for (double rtol : rtols)
-      series.points.push_back(measure(compiled.at(config.backend), *settings, rtol, o.run.atol, *ref, study.measure));
+      series.points.push_back(measure(compiled.at(config.backend), configured, rtol, o.run.atol, *ref, study.measure));
     series.fit = fitProportionality(series.points);
   }
   printTable(study, out);

@@ -30,7 +30,7 @@ struct WorkPrecisionOptions {
   std::string reference;              ///< --reference FILE.csv
   std::string error = "maxabs";       ///< --error maxabs|final|scd
   std::vector<std::string> backends;  ///< --backend llvm,bytecode; empty: llvm
-  std::vector<std::string> solvers;   ///< --solver ida; empty: ida
+  std::vector<std::string> solvers;   ///< --solver ida,arkode,auto; empty: ida
   std::string outputPrefix;           ///< -o PREFIX: PREFIX.csv and PREFIX.svg
   std::string csvPath, svgPath;       ///< --csv, --svg: override the prefix's files
   rt::RunOptions run;                 ///< --start --stop --interval --atol -p --linear-solver --max-steps
