@@ -14,6 +14,7 @@
 #include "driver/Executable.h"
 #include "driver/Modes.h"
 #include "driver/Pipeline.h"
+#include "driver/WorkPrecision.h"
 #include "qdot/exit_code.hpp"
 #include "sim/Run.h"
 
@@ -21,7 +22,7 @@ namespace {
 
 using namespace qdot;
 
-enum class Action { Check, Equations, Run, Build, Modes, Linearize };
+enum class Action { Check, Equations, Run, Build, Modes, Linearize, WorkPrecision };
 
 struct Options {
   std::string file;
@@ -34,6 +35,7 @@ struct Options {
   std::string backend = "llvm";
   bool jitWait = false;  // run --jit-wait
   rt::RunOptions run;
+  driver::WorkPrecisionOptions wp;
   driver::ExecutableOptions exe;
   std::string buildBackend = "llvm";
   std::string at = "equilibrium";  // modes/linearize --at
@@ -218,6 +220,16 @@ ExitCode linearize(driver::Compilation& c, Options& o) {
   return ExitCode::Success;
 }
 
+// qdot wp: the work-precision study (driver/WorkPrecision.h). -p is shared with compileTo, which
+// takes the structural (Integer) assignments out of it.
+ExitCode workPrecision(driver::Compilation& c, Options& o) {
+  o.run.parameters = o.wp.run.parameters;
+  if (std::optional<ExitCode> failed = compileToKernels(c, o)) return *failed;
+  c.diags.render(std::cerr, c.sources, isatty(2));  // warnings, if any
+  o.wp.run.parameters = o.run.parameters;
+  return driver::workPrecision(c, o.file, o.wp, std::cout, std::cerr);
+}
+
 ExitCode dispatch(Action action, Options& o) {
   driver::Compilation c;
   c.options.model = o.model;
@@ -230,6 +242,7 @@ ExitCode dispatch(Action action, Options& o) {
     case Action::Build: return build(c, o);
     case Action::Modes: return modes(c, o);
     case Action::Linearize: return linearize(c, o);
+    case Action::WorkPrecision: return workPrecision(c, o);
   }
   return ExitCode::Internal;
 }
@@ -304,11 +317,14 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"equilibrium", "start"}));
   linearizeCmd->add_flag("--json", o.json, "print JSON for tools instead of CSV blocks");
 
+  auto* wpCmd = addCommand(app, "wp", "Work-precision study: error and cost at a ladder of tolerances (table, CSV, SVG diagram)", o);
+  driver::addWorkPrecisionOptions(*wpCmd, o.wp);
+
   std::string first = argc > 1 ? argv[1] : "";
   bool known = false;
   for (const CLI::App* cmd : app.get_subcommands({})) known = known || cmd->get_name() == first;
   if (!first.empty() && first[0] != '-' && !known) {
-    std::cerr << "qdot: unknown command '" << first << "'; the commands are: check, equations, run, build, modes, linearize (see qdot --help)\n";
+    std::cerr << "qdot: unknown command '" << first << "'; the commands are: check, equations, run, build, modes, linearize, wp (see qdot --help)\n";
     return toInt(ExitCode::Usage);
   }
   if (argc == 1) {
@@ -326,7 +342,8 @@ int main(int argc, char** argv) {
                   : *run ? Action::Run
                   : *build ? Action::Build
                   : *modesCmd ? Action::Modes
-                  : Action::Linearize;
+                  : *linearizeCmd ? Action::Linearize
+                  : Action::WorkPrecision;
   if (action == Action::Build && o.emit.empty() && o.exe.outputPath.empty()) {
     std::cerr << "qdot build: -o,--output is required (the executable to write)\nRun with --help for more information.\n";
     return toInt(ExitCode::Usage);

@@ -1,6 +1,7 @@
-// Per-variable absolute tolerances: scales from nominal values or from the start values, grouped
-// by kind (differential / algebraic) so a zero start value gets a floor tied to its neighbours.
-// The rule is documented in Tolerances.h and runtime/README.md.
+// Per-variable absolute tolerances: the user's atol as given (times nominal), or automatic scales
+// from nominal values or the start values, grouped by kind (differential / algebraic) so a zero
+// start value gets a floor tied to its neighbours. The rule is documented in Tolerances.h and
+// docs/accuracy.md.
 #include "ida/Tolerances.h"
 
 #include <algorithm>
@@ -47,27 +48,39 @@ double median(std::vector<double> values) {
 
 }  // namespace
 
-std::vector<double> toleranceScales(std::span<const double> y0, std::span<const double> nominal,
-                                    std::span<const int32_t> isDifferential) {
-  double all = largestMagnitude(y0, nominal, isDifferential, -1);
-  double floors[2] = {floorFor(largestMagnitude(y0, nominal, isDifferential, 0), all),
-                      floorFor(largestMagnitude(y0, nominal, isDifferential, 1), all)};
-  std::vector<double> scales(y0.size());
-  for (std::size_t i = 0; i < y0.size(); ++i) {
+double calibratedRtol(double rtol) {
+  return std::max(kCalibrationFactor * std::pow(rtol, kCalibrationExponent), std::min(rtol, kSolverRtolFloor));
+}
+
+std::vector<double> toleranceScales(std::span<const double> y, std::span<const double> nominal,
+                                    std::span<const int32_t> isDifferential, std::span<const double> start) {
+  if (start.empty()) start = y;
+  double all = largestMagnitude(start, nominal, isDifferential, -1);
+  double floors[2] = {floorFor(largestMagnitude(start, nominal, isDifferential, 0), all),
+                      floorFor(largestMagnitude(start, nominal, isDifferential, 1), all)};
+  std::vector<double> scales(y.size());
+  for (std::size_t i = 0; i < y.size(); ++i) {
     if (hasNominal(nominal[i])) {
       scales[i] = nominal[i];
     } else {
-      scales[i] = std::max(magnitude(y0[i], 0.0), floors[isDifferential[i] != 0 ? 1 : 0]);
+      scales[i] = std::max(magnitude(y[i], 0.0), floors[isDifferential[i] != 0 ? 1 : 0]);
     }
   }
   return scales;
 }
 
-ToleranceVector buildTolerances(double rtol, std::optional<double> atol, std::span<const double> y0,
-                                std::span<const double> nominal, std::span<const int32_t> isDifferential) {
+ToleranceVector buildTolerances(double rtol, std::optional<double> atol, std::span<const double> y,
+                                std::span<const double> nominal, std::span<const int32_t> isDifferential,
+                                std::span<const double> start) {
   ToleranceVector result;
-  result.scale = toleranceScales(y0, nominal, isDifferential);
-  double base = atol.value_or(rtol);
+  if (atol) {
+    result.scale.resize(y.size());
+    for (std::size_t i = 0; i < y.size(); ++i) result.scale[i] = hasNominal(nominal[i]) ? nominal[i] : 1.0;
+  } else {
+    result.scale = toleranceScales(y, nominal, isDifferential, start);
+  }
+  result.solverRtol = atol ? rtol : calibratedRtol(rtol);
+  double base = atol.value_or(result.solverRtol);  // automatic: the calibrated rtol, relative and absolute alike
   result.atol.reserve(result.scale.size());
   for (double scale : result.scale) {
     double value = base * scale;
@@ -77,6 +90,7 @@ ToleranceVector buildTolerances(double rtol, std::optional<double> atol, std::sp
   }
   ToleranceSummary& s = result.summary;
   s.rtol = rtol;
+  s.solverRtol = result.solverRtol;
   s.atolUser = base;
   s.atolGiven = atol.has_value();
   s.count = result.atol.size();
@@ -89,6 +103,15 @@ ToleranceVector buildTolerances(double rtol, std::optional<double> atol, std::sp
     s.atolMedian = median(result.atol);
   }
   return result;
+}
+
+void useAsGiven(ToleranceVector& t) {
+  ToleranceSummary& s = t.summary;
+  if (s.atolGiven || t.solverRtol >= s.rtol) return;
+  double relaxed = s.rtol / t.solverRtol;
+  for (double& a : t.atol) a *= relaxed;
+  s.atolMin *= relaxed, s.atolMedian *= relaxed, s.atolMax *= relaxed;
+  s.atolUser = t.solverRtol = s.solverRtol = s.rtol;
 }
 
 }  // namespace qdot::rt

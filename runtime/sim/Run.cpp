@@ -4,6 +4,9 @@
 
 #include <fmt/format.h>
 
+#include <unistd.h>
+
+#include <iostream>
 #include <memory>
 
 #include "output/CsvWriter.h"
@@ -44,6 +47,8 @@ ExitCode runModel(const QdotModel& model, const RunOptions& options, const Exper
     log << "error: " << e.what() << '\n';
     return ExitCode::Usage;
   }
+  // Progress only where a person watches: standard error is a terminal (never into a log file).
+  if (run.progress && &log == &std::cerr && isatty(STDERR_FILENO)) run.settings.progress = &log;
   SimulationResult result = simulate(model, run.settings, *writer);
   report(result, run.stats, log);
   return result.success ? ExitCode::Success : ExitCode::SimulationFailed;

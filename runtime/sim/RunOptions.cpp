@@ -19,7 +19,9 @@ void addRunOptions(CLI::App& app, RunOptions& o) {
   app.add_option("--stop", o.stop, "stop time (default: experiment annotation, else 1)");
   app.add_option("--interval", o.interval, "output interval (default: (stop - start) / 500)");
   app.add_option("--rtol", o.rtol, "relative tolerance (default: experiment annotation, else 1e-6)");
-  app.add_option("--atol", o.atol, "absolute tolerance, scaled per variable (default: rtol)");
+  app.add_option("--atol", o.atol,
+                 "absolute tolerance in each variable's units (times its nominal, if it has one); default: "
+                 "automatic per-variable scales (docs/accuracy.md)");
   app.add_option("-p,--parameter", o.parameters, "set a parameter: -p NAME=VALUE (repeatable)")
       ->type_name("NAME=VALUE")
       ->allow_extra_args(false);
@@ -44,6 +46,9 @@ void addRunOptions(CLI::App& app, RunOptions& o) {
                  "CSV header: modelica (der(x), x[1]; default) or identifier (der_x, x_1: for numpy and other "
                  "tools that take identifiers only)")
       ->check(CLI::IsMember({"modelica", "identifier"}));
+  app.add_option("--max-steps", o.maxSteps, "stop with an error after this many solver steps (the rows so far are kept)");
+  app.add_flag("--force", o.force, "write the output even if it has more than 10^7 rows");
+  app.add_flag("!--no-progress", o.progress, "never show progress (otherwise shown on a terminal for runs of more than 3 s)");
 }
 
 std::optional<double> parseNumber(std::string_view text) {
@@ -112,6 +117,16 @@ void checkTimes(double start, double stop, double interval) {
     throw UsageError(fmt::format("--interval ({}) is longer than the simulated span [{}, {}]", interval, start, stop));
 }
 
+// The row count is computed as a double first: an interval of 1e-300 must be refused, not overflow.
+void checkRowCount(double start, double stop, double interval, bool force) {
+  double rows = std::floor((stop - start) / interval) + 1;
+  if (rows <= kMaxRowsWithoutForce || force) return;
+  std::string count = rows < 1e15 ? fmt::format("{:.0f}", rows) : fmt::format("{:.3g}", rows);
+  throw UsageError(fmt::format("--interval {} would write {} rows over [{}, {}] (more than {:.0e}); give a longer "
+                               "--interval, or --force if that many rows are meant",
+                               interval, count, start, stop, kMaxRowsWithoutForce));
+}
+
 }  // namespace
 
 ParameterOverrides parameterOverrides(const QdotModel& model, const std::vector<std::string>& assignments) {
@@ -154,6 +169,9 @@ ResolvedRun resolveRunOptions(const RunOptions& o, const ExperimentDefaults& e, 
   double fallback = (s.stop - s.start) / kDefaultIntervals;
   s.interval = o.interval.value_or(spanChanged ? fallback : e.interval.value_or(fallback));
   checkTimes(s.start, s.stop, s.interval);
+  checkRowCount(s.start, s.stop, s.interval, o.force);
+  if (o.maxSteps && *o.maxSteps <= 0) throw UsageError(fmt::format("--max-steps must be positive (got {})", *o.maxSteps));
+  s.maxSteps = o.maxSteps;
   s.rtol = o.rtol.value_or(e.tolerance.value_or(kDefaultRtol));
   s.atol = o.atol;
   checkTolerances(s.rtol, s.atol);
@@ -183,6 +201,7 @@ ResolvedRun resolveRunOptions(const RunOptions& o, const ExperimentDefaults& e, 
     throw UsageError(fmt::format("--csv-names must be modelica or identifier (got '{}')", o.csvNames));
   run.csvNames = o.csvNames == "identifier" ? ColumnNaming::Identifier : ColumnNaming::Modelica;
   run.stats = o.stats;
+  run.progress = o.progress;
   return run;
 }
 

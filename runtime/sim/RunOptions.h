@@ -30,6 +30,10 @@ struct RunOptions {
   bool invariants = false;              ///< --invariants
   std::string linearSolver = "auto";    ///< --linear-solver dense|klu|auto
   std::string csvNames = "modelica";    ///< --csv-names modelica|identifier
+  // Guards against runs that cannot end well (issue 11 §5).
+  std::optional<long> maxSteps;  ///< --max-steps N: solver steps allowed over the whole run
+  bool force = false;            ///< --force: write more than kMaxRowsWithoutForce rows
+  bool progress = true;          ///< false with --no-progress; shown only on a terminal, see Run.h
   // --solver (issue 11, section 3)
   std::string solver = "ida";  ///< --solver ida|arkode|auto
   std::string preserve;        ///< --preserve invariants (issue 11, section 4); "" = none
@@ -43,11 +47,14 @@ struct ExperimentDefaults {
 inline constexpr double kDefaultStop = 1.0;       ///< s, without an experiment annotation
 inline constexpr double kDefaultIntervals = 500;  ///< output intervals over [start, stop]
 inline constexpr double kDefaultRtol = 1e-6;
+/// More output rows than this (a CSV of about a gigabyte) need --force: an --interval typed with a
+/// wrong exponent is refused before it fills the disk.
+inline constexpr double kMaxRowsWithoutForce = 1e7;
 /// The smallest --rtol accepted: 10 × DBL_EPSILON (issue 11, section 5).
 inline constexpr double kRoundOffFloor = 10 * 2.220446049250313e-16;
 
 /// Adds --start --stop --interval --rtol --atol -p --outputs -o --stats --invariants
-/// --linear-solver --csv-names to app, storing into options (which must outlive the parse).
+/// --linear-solver --csv-names --max-steps --force --no-progress to app, storing into options (which must outlive the parse).
 void addRunOptions(CLI::App& app, RunOptions& options);
 
 /// The whole of text as a finite number (std::from_chars, no trailing characters), or nullopt.
@@ -80,11 +87,12 @@ struct ResolvedRun {
   std::string outputPath;  ///< empty = standard output
   ColumnNaming csvNames = ColumnNaming::Modelica;
   bool stats = false;
+  bool progress = true;  ///< the user did not turn progress off
 };
 
 /// Applies defaults (user value, else experiment annotation, else stop 1 s, 500 intervals, rtol
 /// 1e-6; the annotation's interval is used only when start and stop are not overridden), checks
-/// everything and evaluates the parameters. Throws UsageError for a bad option,
+/// everything (more than kMaxRowsWithoutForce rows without --force is a UsageError) and evaluates the parameters. Throws UsageError for a bad option,
 /// std::runtime_error when the model's parameter function fails.
 ResolvedRun resolveRunOptions(const RunOptions& options, const ExperimentDefaults& experiment, const QdotModel& model);
 

@@ -95,15 +95,65 @@ class RowBuilder {
   bool needOutputs_ = false, needInvariants_ = false;
 };
 
+/// "t = 3.2 of 10 (32 %)" on one terminal line, rewritten at most twice a second once the solve has
+/// taken kProgressAfter seconds, and erased at the end so the terminal shows only the result.
+class ProgressLine {
+ public:
+  ProgressLine(std::ostream* out, double start, double stop) : out_(out), start_(start), stop_(stop) {}
+  ~ProgressLine() {
+    if (shown_) *out_ << "\r\033[K" << std::flush;
+  }
+  void update(double t) {
+    if (!out_) return;
+    double elapsed = secondsSince(began_);
+    if (elapsed < kProgressAfter || elapsed - lastShown_ < 0.5) return;
+    lastShown_ = elapsed;
+    shown_ = true;
+    double percent = 100 * (t - start_) / (stop_ - start_);
+    *out_ << fmt::format("\r\033[Kt = {:.6g} of {:.6g} ({:.0f} %), {:.0f} s", t, stop_, percent, elapsed) << std::flush;
+  }
+
+ private:
+  std::ostream* out_;
+  double start_, stop_;
+  Clock::time_point began_ = Clock::now();
+  double lastShown_ = 0;
+  bool shown_ = false;
+};
+
+/// --max-steps: IDA counts steps per call (IDASetMaxNumSteps), so the limit over the run is
+/// checked after every output time, and IDA's own limit per call is lowered to it.
+template <class Session>
+void checkStepLimit(const SimulationSettings& s, const Session& session) {
+  if (!s.maxSteps) return;
+  long steps = session.stats().steps;
+  if (steps >= *s.maxSteps && session.time() < s.stop)
+    throw IdaError(fmt::format("the run reached --max-steps {} ({} steps taken); allow more steps or loosen --rtol",
+                               *s.maxSteps, steps),
+                   session.time());
+}
+
 SessionOptions sessionOptions(const SimulationSettings& s) {
   SessionOptions o;
   o.t0 = s.start;
   o.rtol = s.rtol;
   o.atol = s.atol;
   o.linearSolver = s.linearSolver;
-  o.maxStepsPerOutput = s.maxStepsPerOutput;
+  o.maxStepsPerOutput = s.maxSteps ? std::min(s.maxStepsPerOutput, *s.maxSteps) : s.maxStepsPerOutput;
   o.preserveInvariants = s.preserveInvariants;
   return o;
+}
+
+/// advanceTo; a failure caused by the --max-steps limit (IDA_TOO_MUCH_WORK within one interval)
+/// is reported as that limit, not as the solver's generic message.
+template <class Session>
+double advanceWithin(const SimulationSettings& s, Session& session, double tout) {
+  try {
+    return session.advanceTo(tout);
+  } catch (const IdaError&) {
+    checkStepLimit(s, session);
+    throw;
+  }
 }
 
 template <class Session>
@@ -204,11 +254,14 @@ SimulationResult simulateWith(const QdotModel& model, const SimulationSettings& 
     result.setupSeconds = secondsSince(clock);
     clock = Clock::now();
     solving = true;
+    ProgressLine progress(settings.progress, settings.start, settings.stop);
     for (std::size_t k = 0; k < grid.size(); ++k) {
-      double t = k == 0 ? session->time() : session->advanceTo(grid[k]);
+      double t = k == 0 ? session->time() : advanceWithin(settings, *session, grid[k]);
       sink.row(t, rows.build(t, session->y(), session->yp()));
       ++result.rows;
       result.lastRowTime = t;
+      checkStepLimit(settings, *session);
+      progress.update(t);
     }
     result.success = true;
   } catch (const IdaError& e) {

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -57,10 +58,15 @@ struct SimulationSettings {
   std::vector<Column> columns;     ///< empty = defaultColumns(model, invariants)
   bool invariants = false;         ///< with empty columns: add the invariant columns
   long maxStepsPerOutput = 100000;
+  std::optional<long> maxSteps;        ///< steps allowed over the whole run (--max-steps); none = no limit
+  std::ostream* progress = nullptr;    ///< a terminal: progress once the run is longer than kProgressAfter
   // --solver (issue 11, section 3): which integrator; Auto picks from the linearization at the start.
   SolverKind solver = SolverKind::Ida;
   bool preserveInvariants = false;  ///< --preserve invariants: project onto their start values (arkode)
 };
+
+/// Seconds of solving after which progress is shown (when SimulationSettings::progress is set).
+inline constexpr double kProgressAfter = 3.0;
 
 /// How a run went.
 struct SimulationResult {

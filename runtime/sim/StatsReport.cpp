@@ -13,9 +13,14 @@ void line(std::string& out, std::string_view label, const std::string& value) {
 }
 
 std::string toleranceText(const ToleranceSummary& t) {
-  std::string atolSource = t.atolGiven ? fmt::format("atol {:g}", t.atolUser) : "atol = rtol";
-  return fmt::format("rtol {:g}, {} x scale: atol min {:.3g}, median {:.3g}, max {:.3g} ({} of {} scales automatic)",
-                     t.rtol, atolSource, t.atolMin, t.atolMedian, t.atolMax, t.automatic, t.count);
+  std::string range = fmt::format("atol min {:.3g}, median {:.3g}, max {:.3g}", t.atolMin, t.atolMedian, t.atolMax);
+  std::size_t nominal = t.count - t.automatic;
+  if (t.atolGiven)
+    return fmt::format("rtol {:g}, atol {:g} absolute ({} of {} unknowns with a nominal: atol x nominal): {}", t.rtol,
+                       t.atolUser, nominal, t.count, range);
+  return fmt::format("rtol {:g} (to IDA as {:.3g}, calibrated for the global error), atol = that x scale, {} of {} "
+                     "scales automatic (max(|value|, 1e-3 x largest start value of its kind); docs/accuracy.md): {}",
+                     t.rtol, t.solverRtol, t.automatic, t.count, range);
 }
 
 }  // namespace

@@ -140,6 +140,13 @@ check linearize-bad-p 2 "$qdot" linearize "$src/examples/textbook/utube.qd" -p n
 for f in "$src"/examples/*/*.qd; do
   check "json-$(basename "$f")" 0 sh -c "'$qdot' equations '$f' --json | python3 -m json.tool"
 done
+# Guards (issue 11 §5): an --interval that would write 10^10 rows is refused with the count; with
+# --max-steps the run stops with an error naming the limit and keeps the rows written so far.
+check rows-refused 2 "$qdot" run "$src/examples/textbook/utube.qd" --interval 1e-9
+contains rows-count "would write 10000000001 rows" "$qdot" run "$src/examples/textbook/utube.qd" --interval 1e-9
+check max-steps 3 "$qdot" run "$src/examples/textbook/utube.qd" --max-steps 50
+contains max-steps-message "reached --max-steps 50" "$qdot" run "$src/examples/textbook/utube.qd" --max-steps 50
+contains max-steps-rows "rows up to t =" "$qdot" run "$src/examples/textbook/utube.qd" --max-steps 50
 rm -f /tmp/qdot_cli_out.$$
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -99,6 +99,27 @@ TEST(ModelFailure, SilentNanIsReportedWithTheEquationIndex) {
   EXPECT_TRUE(sink.finished);
 }
 
+// --max-steps: the run stops with an error naming the limit; the rows before stay written.
+TEST(ModelFailure, MaxStepsStopsTheRunAndKeepsTheRows) {
+  HandModel model = failingAfterHalf();
+  model.residual = [](double t, const double*, const double* yp, const double*, double* F) {
+    F[0] = yp[0] - std::cos(50 * t);  // x = sin(50 t)/50: steps all the way
+    return 0;
+  };
+  SimulationSettings s;
+  s.interval = 0.05;
+  s.maxSteps = 200;
+  MemorySink sink;
+  SimulationResult r = simulate(model.abi(), s, sink);
+  EXPECT_FALSE(r.success);
+  EXPECT_NE(r.message.find("reached --max-steps 200"), std::string::npos) << r.message;
+  EXPECT_GE(r.stats.steps, 200);
+  EXPECT_LE(r.stats.steps, 400);  // checked at output times; IDA's own limit per interval is 200 too
+  EXPECT_EQ(sink.rows.size(), r.rows);
+  EXPECT_GT(sink.rows.size(), 1u) << r.message << " steps " << r.stats.steps;
+  EXPECT_LT(r.failureTime, 1.0);
+}
+
 // A failure at the start time is reported before IDA runs, at t0.
 TEST(ModelFailure, FailureAtTheStartIsReportedAtTheStartTime) {
   HandModel model = failingAfterHalf();

@@ -113,6 +113,20 @@ TEST(RunOptionsValidation, TimesMustMakeASpan) {
             "the stop time (1) must be greater than the start time (5)");
 }
 
+// The output-size guard counts rows before anything runs (an interval of 1e-300 is refused, not an
+// overflow); --force lets a large but intended output through.
+TEST(RunOptionsValidation, MoreThanTenMillionRowsNeedForce) {
+  EXPECT_EQ(usageError({"--stop", "10", "--interval", "1e-9"}),
+            "--interval 1e-09 would write 10000000001 rows over [0, 10] (more than 1e+07); give a longer --interval, or "
+            "--force if that many rows are meant");
+  EXPECT_NE(usageError({"--interval", "1e-300"}).find("would write 1e+300 rows"), std::string::npos);
+  EXPECT_NE(usageError({"--interval", "1e-7"}).find("would write 10000001 rows"), std::string::npos);
+  EXPECT_EQ(usageError({"--interval", "2e-7"}), "(no error)");  // 5 000 001 rows
+  EXPECT_EQ(usageError({"--stop", "10", "--interval", "1e-9", "--force"}), "(no error)");
+  EXPECT_EQ(usageError({"--max-steps", "0"}), "--max-steps must be positive (got 0)");
+  EXPECT_EQ(resolve({"--max-steps", "20"}).settings.maxSteps, 20);
+}
+
 TEST(RunOptionsValidation, ParameterMistakes) {
   EXPECT_EQ(usageError({"-p", "omgea=3"}), "unknown parameter 'omgea' (did you mean 'omega'?)");
   EXPECT_EQ(usageError({"-p", "zeta=3"}), "unknown parameter 'zeta'; the model has: omega");

@@ -41,36 +41,60 @@ TEST(ToleranceScales, ZeroKindFallsBackToAllThenToOne) {
   EXPECT_DOUBLE_EQ(s[2], 3e-3);  // 1e-3 * largest algebraic (3)
 }
 
-TEST(ToleranceVector, AtolIsUserAtolTimesScaleAndDefaultsToRtol) {
+TEST(ToleranceVector, AutomaticAtolIsRtolTimesScale) {
   std::vector<double> y0 = {1e-8, 3, 0};
   std::vector<double> nominal = {0, 0, 0};
   std::vector<int32_t> kind = {1, 1, 1};
   ToleranceVector v = buildTolerances(1e-6, std::nullopt, y0, nominal, kind);
+  const double c = calibratedRtol(1e-6);  // the rtol handed to IDA, and the base of the automatic atol
   ASSERT_EQ(v.atol.size(), 3u);
-  EXPECT_DOUBLE_EQ(v.atol[0], 1e-6 * 3e-3);  // floor 1e-3 * 3 beats |1e-8|
-  EXPECT_DOUBLE_EQ(v.atol[1], 1e-6 * 3);
-  EXPECT_DOUBLE_EQ(v.atol[2], 1e-6 * 3e-3);
+  EXPECT_DOUBLE_EQ(v.atol[0], c * 3e-3);  // floor 1e-3 * 3 beats |1e-8|
+  EXPECT_DOUBLE_EQ(v.atol[1], c * 3);
+  EXPECT_DOUBLE_EQ(v.atol[2], c * 3e-3);
   EXPECT_FALSE(v.summary.atolGiven);
-  EXPECT_EQ(v.summary.atolUser, 1e-6);
+  EXPECT_EQ(v.summary.atolUser, c);
   EXPECT_EQ(v.summary.automatic, 3u);
-  EXPECT_DOUBLE_EQ(v.summary.atolMin, 3e-9);
-  EXPECT_DOUBLE_EQ(v.summary.atolMedian, 3e-9);
-  EXPECT_DOUBLE_EQ(v.summary.atolMax, 3e-6);
+  EXPECT_DOUBLE_EQ(v.summary.atolMin, c * 3e-3);
+  EXPECT_DOUBLE_EQ(v.summary.atolMedian, c * 3e-3);
+  EXPECT_DOUBLE_EQ(v.summary.atolMax, c * 3);
 
-  nominal = {1e-8, 0, 0};
+}
+
+// A given atol is absolute in each variable's units (SUNDIALS, SciPy): the start values do not
+// scale it; only a nominal does.
+TEST(ToleranceVector, GivenAtolIsAbsoluteExceptTimesNominal) {
+  std::vector<double> y0 = {1e-8, 3, 0};
+  std::vector<double> nominal = {1e-8, 0, 0};
+  std::vector<int32_t> kind = {1, 1, 0};
   ToleranceVector w = buildTolerances(1e-6, 1e-4, y0, nominal, kind);
-  EXPECT_DOUBLE_EQ(w.atol[0], 1e-4 * 1e-8);
-  EXPECT_DOUBLE_EQ(w.atol[1], 1e-4 * 3);
+  EXPECT_DOUBLE_EQ(w.atol[0], 1e-4 * 1e-8);  // nominal
+  EXPECT_EQ(w.atol[1], 1e-4);                // not 1e-4 * 3
+  EXPECT_EQ(w.atol[2], 1e-4);                // not 1e-4 * 3e-3 for a zero start
   EXPECT_TRUE(w.summary.atolGiven);
   EXPECT_EQ(w.summary.automatic, 2u);
-  EXPECT_DOUBLE_EQ(w.summary.atolMedian, 3e-7);  // {1e-12, 3e-7, 3e-4}
+  EXPECT_DOUBLE_EQ(w.summary.atolMin, 1e-12);
+  EXPECT_DOUBLE_EQ(w.summary.atolMedian, 1e-4);
+}
+
+// A model at rest: every start value is 0, and IDACalcIC leaves roundoff (4e-13) in an algebraic
+// unknown. The floors come from the start values as written (all zero: the unit, 1), so the
+// roundoff does not become a scale of 4e-16; a consistent value above the floor still raises it.
+TEST(ToleranceScales, RoundoffAfterCalcICDoesNotShrinkTheFloor) {
+  std::vector<double> start = {0, 0, 0}, consistent = {0, 0, 4e-13}, nominal = {0, 0, 0};
+  std::vector<int32_t> kind = {1, 1, 0};
+  EXPECT_EQ(toleranceScales(consistent, nominal, kind, start), (std::vector<double>{1, 1, 1}));
+  EXPECT_DOUBLE_EQ(toleranceScales(consistent, nominal, kind)[2], 4e-13);  // what the floor was before
+  consistent[2] = 25;
+  EXPECT_EQ(toleranceScales(consistent, nominal, kind, start)[2], 25);
 }
 
 TEST(ToleranceVector, MedianOfAnEvenCountIsTheMeanOfTheMiddleTwo) {
   std::vector<double> y0 = {1, 2, 4, 8};
   std::vector<int32_t> kind(4, 1);
-  ToleranceVector v = buildTolerances(1.0, std::nullopt, y0, std::vector<double>(4, 0.0), kind);
-  EXPECT_DOUBLE_EQ(v.summary.atolMedian, 3.0);
+  ToleranceVector v = buildTolerances(0.5, 1.0, y0, std::vector<double>(4, 0.0), kind);
+  EXPECT_DOUBLE_EQ(v.summary.atolMedian, 1.0);
+  ToleranceVector w = buildTolerances(1.0, std::nullopt, y0, std::vector<double>(4, 0.0), kind);
+  EXPECT_DOUBLE_EQ(w.summary.atolMedian, 3.0 * calibratedRtol(1.0));
 }
 
 TEST(ToleranceVector, TheSessionUsesNominalAndConsistentValues) {
@@ -81,12 +105,15 @@ TEST(ToleranceVector, TheSessionUsesNominalAndConsistentValues) {
   IdaSession session(dae.abi(), {}, o);
   session.initialize(0.1);
   ASSERT_EQ(session.absoluteTolerances().size(), 2u);
-  EXPECT_DOUBLE_EQ(session.absoluteTolerances()[0], 1e-6);    // |y1(0)| = 1
-  EXPECT_DOUBLE_EQ(session.absoluteTolerances()[1], 0.5e-6);  // |y2(0)| = 1/2 after CalcIC
-  // Robertson: nominal 1e-5 on y2 gives atol 1e-5 * rtol there.
+  const double c = calibratedRtol(1e-6);
+  EXPECT_DOUBLE_EQ(session.absoluteTolerances()[0], c);        // |y1(0)| = 1
+  EXPECT_DOUBLE_EQ(session.absoluteTolerances()[1], 0.5 * c);  // |y2(0)| = 1/2 after CalcIC
+  // Robertson: nominal 1e-5 on y2 gives atol 1e-5 * (calibrated) rtol there.
   HandModel rob = robertson();
   IdaSession second(rob.abi(), {}, o);
-  EXPECT_DOUBLE_EQ(second.absoluteTolerances()[1], 1e-11);
+  EXPECT_DOUBLE_EQ(second.absoluteTolerances()[1], 1e-5 * 1e-6);  // before initialize: as given, for IDACalcIC
+  second.initialize(0.1);
+  EXPECT_DOUBLE_EQ(second.absoluteTolerances()[1], 1e-5 * c);     // the run: calibrated
   EXPECT_EQ(second.tolerances().automatic, 2u);
 }
 
@@ -120,6 +147,20 @@ TEST(ToleranceVector, TinyVariableStaysAccurate) {
   }
   std::printf("  x = 1e-8 exp(-t), rtol 1e-6: max relative error %.3g\n", worst);
   EXPECT_LT(worst, 1e-4);
+}
+
+// Without --atol, IDA gets a tighter rtol so that the global error follows the requested one
+// (docs/accuracy.md); with --atol, both tolerances go to IDA as given.
+TEST(ToleranceVector, CalibratedRtolOnlyWithoutAtol) {
+  EXPECT_NEAR(calibratedRtol(1e-6), 0.5 * std::pow(1e-6, 1.15), 1e-20);
+  EXPECT_LT(calibratedRtol(1e-3), 1e-3);
+  EXPECT_GT(calibratedRtol(1e-3), 1e-4);
+  EXPECT_EQ(calibratedRtol(1e-10), 1e-11);   // never below IDA's round-off limit...
+  EXPECT_EQ(calibratedRtol(1e-12), 1e-12);   // ...unless asked for directly
+  std::vector<double> y0 = {1, 2};
+  std::vector<int32_t> kind = {1, 1};
+  EXPECT_EQ(buildTolerances(1e-6, std::nullopt, y0, std::vector<double>(2, 0.0), kind).solverRtol, calibratedRtol(1e-6));
+  EXPECT_EQ(buildTolerances(1e-6, 1e-9, y0, std::vector<double>(2, 0.0), kind).solverRtol, 1e-6);
 }
 
 }  // namespace
