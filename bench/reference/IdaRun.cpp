@@ -156,7 +156,8 @@ void Integrator::applyTolerances() {
   tolerances_ = rt::buildTolerances(settings_.rtol, settings_.atol, {data(y_), static_cast<std::size_t>(n_)}, nominal,
                                     differential);
   std::copy(tolerances_.atol.begin(), tolerances_.atol.end(), data(atol_));
-  check(IDASVtolerances(ida_, settings_.rtol, atol_), "IDASVtolerances");
+  // qdot's solver rtol (calibrated without --atol, runtime/ida/Tolerances.h): the same IDA settings
+  check(IDASVtolerances(ida_, tolerances_.solverRtol, atol_), "IDASVtolerances");
 }
 
 void Integrator::attachLinearSolver() {
