@@ -48,20 +48,7 @@ TEST(Arkode, PendulumPeriodAndEnergyMatchIda) {
     ASSERT_EQ(r.exitCode, 0) << r.log;
     if (header.empty()) header = r.header;
     EXPECT_EQ(r.header, header) << solver;
-    const auto &t = r.time(), &th = r.col("theta"), &v = r.col("der(theta)");
-    std::vector<double> crossings;
-    for (std::size_t i = 0; i + 1 < th.size(); ++i)
-      if (th[i] < 0 && th[i + 1] >= 0) {  // cubic Hermite root between the rows
-        const double h = t[i + 1] - t[i];
-        auto at = [&](double s) {
-          const double s2 = s * s, s3 = s2 * s;
-          return (2 * s3 - 3 * s2 + 1) * th[i] + (s3 - 2 * s2 + s) * h * v[i] + (-2 * s3 + 3 * s2) * th[i + 1] +
-                 (s3 - s2) * h * v[i + 1];
-        };
-        double lo = 0, hi = 1;
-        for (int k = 0; k < 60; ++k) (at(0.5 * (lo + hi)) < 0 ? lo : hi) = 0.5 * (lo + hi);
-        crossings.push_back(t[i] + 0.5 * (lo + hi) * h);
-      }
+    std::vector<double> crossings = upwardZeroCrossings(r, "theta", "der(theta)");
     ASSERT_EQ(crossings.size(), 10u) << solver;
     EXPECT_NEAR((crossings.back() - crossings.front()) / 9, period, 1e-6 * period) << solver;
     const double mgl = g * l;

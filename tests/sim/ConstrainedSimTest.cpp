@@ -65,26 +65,6 @@ Dual sin(Dual a) { return {std::sin(a.v), a.d * std::cos(a.v)}; }
 Dual cos(Dual a) { return {std::cos(a.v), -a.d * std::sin(a.v)}; }
 Dual sqrt(Dual a) { return {std::sqrt(a.v), a.d / (2 * std::sqrt(a.v))}; }
 
-// Times where column x crosses zero upwards, each located on the cubic Hermite interpolant of x and
-// its derivative column v between two output times (error O(h⁴), far below the tolerances here).
-std::vector<double> upwardZeroCrossings(const RunResult& r, const std::string& x, const std::string& v) {
-  const auto &t = r.time(), &xs = r.col(x), &vs = r.col(v);
-  std::vector<double> crossings;
-  for (std::size_t i = 0; i + 1 < xs.size() && i + 1 < vs.size(); ++i) {
-    if (!(xs[i] < 0 && xs[i + 1] >= 0)) continue;
-    const double h = t[i + 1] - t[i];
-    auto hermite = [&](double s) {
-      const double s2 = s * s, s3 = s2 * s;
-      return (2 * s3 - 3 * s2 + 1) * xs[i] + (s3 - 2 * s2 + s) * h * vs[i] + (-2 * s3 + 3 * s2) * xs[i + 1] +
-             (s3 - s2) * h * vs[i + 1];
-    };
-    double lo = 0, hi = 1;
-    for (int k = 0; k < 60; ++k) (hermite(0.5 * (lo + hi)) < 0 ? lo : hi) = 0.5 * (lo + hi);
-    crossings.push_back(t[i] + 0.5 * (lo + hi) * h);
-  }
-  return crossings;
-}
-
 // The largest |value| of a column over all output rows (infinite if any is nan).
 double maxAbs(const RunResult& r, const std::string& name) {
   double m = 0;

@@ -31,28 +31,7 @@ Deviation expectOscillation(const RunResult& r, const std::string& name, const F
 // ---------------------------------------------------------------------------------------------
 // Measurements on a sampled oscillation.
 
-// Times where x crosses zero upwards, each located on the cubic Hermite interpolant of x and ẋ
-// between two output times (error O(h⁴), far below the tolerances here).
-std::vector<double> upwardZeroCrossings(const RunResult& r, const std::string& x, const std::string& v) {
-  const auto &t = r.time(), &xs = r.col(x), &vs = r.col(v);
-  std::vector<double> crossings;
-  for (std::size_t i = 0; i + 1 < xs.size(); ++i) {
-    if (!(xs[i] < 0 && xs[i + 1] >= 0)) continue;
-    const double h = t[i + 1] - t[i];
-    auto hermite = [&](double s) {  // s in [0, 1]
-      double s2 = s * s, s3 = s2 * s;
-      return (2 * s3 - 3 * s2 + 1) * xs[i] + (s3 - 2 * s2 + s) * h * vs[i] + (-2 * s3 + 3 * s2) * xs[i + 1] +
-             (s3 - s2) * h * vs[i + 1];
-    };
-    double lo = 0, hi = 1;
-    for (int k = 0; k < 60; ++k) {
-      double mid = 0.5 * (lo + hi);
-      (hermite(mid) < 0 ? lo : hi) = mid;
-    }
-    crossings.push_back(t[i] + 0.5 * (lo + hi) * h);
-  }
-  return crossings;
-}
+// upwardZeroCrossings (QdotRun.h) locates each period's zero crossing.
 
 // The mean period between the first and the last upward zero crossing.
 double measuredPeriod(const RunResult& r, const std::string& x, const std::string& v) {

@@ -10,25 +10,6 @@
 namespace qdot::simtest {
 namespace {
 
-// Times at which x crosses zero upwards (cubic Hermite interpolation between rows with x and ẋ).
-std::vector<double> upwardCrossings(const RunResult& r, const std::string& x, const std::string& v) {
-  const auto &t = r.time(), &xs = r.col(x), &vs = r.col(v);
-  std::vector<double> crossings;
-  for (std::size_t i = 0; i + 1 < xs.size() && i + 1 < vs.size(); ++i) {
-    if (!(xs[i] < 0 && xs[i + 1] >= 0)) continue;
-    const double h = t[i + 1] - t[i];
-    auto hermite = [&](double s) {
-      const double s2 = s * s, s3 = s2 * s;
-      return (2 * s3 - 3 * s2 + 1) * xs[i] + (s3 - 2 * s2 + s) * h * vs[i] + (-2 * s3 + 3 * s2) * xs[i + 1] +
-             (s3 - s2) * h * vs[i + 1];
-    };
-    double lo = 0, hi = 1;
-    for (int k = 0; k < 60; ++k) (hermite(0.5 * (lo + hi)) < 0 ? lo : hi) = 0.5 * (lo + hi);
-    crossings.push_back(t[i] + 0.5 * (lo + hi) * h);
-  }
-  return crossings;
-}
-
 // A counter from --stats ("  steps                  14512 (last step …").
 long statistic(const RunResult& r, const std::string& label) {
   std::smatch m;
@@ -180,7 +161,7 @@ TEST(VanDerPol, RelaxationPeriodAtMu1000) {
   const double firstOrder = (3 - 2 * std::log(2.0)) * mu, period = firstOrder + 3 * airy * std::cbrt(1 / mu);
   auto r = runQdot("tests/stability/models/van_der_pol.qd", {"--rtol", "1e-8"});
   ASSERT_EQ(r.exitCode, 0) << r.log;
-  auto crossings = upwardCrossings(r, "x", "der(x)");
+  auto crossings = upwardZeroCrossings(r, "x", "der(x)");
   ASSERT_GE(crossings.size(), 2u);
   const double measured = (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
   std::cout << "[measured] period " << num(measured) << " s; asymptotic " << num(period) << " s\n";
