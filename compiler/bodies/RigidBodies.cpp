@@ -220,6 +220,7 @@ class ClassLowering {
         hasInertia |= m.name == "inertia";
         s.hasCm |= m.name == "cm";
         if (m.name == "inertia") ok &= lowerInertia(m, s);
+        if (m.name == "mass") ok &= checkMass(*m.value);
         mods.push_back(std::move(m));
       } else if (m.name == "q" || m.name == "omega" || m.name == "r" || m.name == "v") {
         if (m.value) {
@@ -245,6 +246,14 @@ class ClassLowering {
       error(d.nameRange, DiagCode::E0701, std::string("the body '") + d.name + "' has no " + (hasMass ? "inertia" : "mass"),
             "give it: body " + d.name + "(mass = 1, inertia = {0.1, 0.1, 0.2});");
     return ok && hasMass && hasInertia;
+  }
+
+  // A mass known at compile time must be positive (a massless or negative body has no dynamics).
+  bool checkMass(const Expr& value) {
+    std::optional<double> mass = fold_(&value);
+    if (!mass || *mass > 0) return true;
+    error(value.range, DiagCode::E0701, "the mass of a body must be positive", "give its mass in kg, e.g. mass = 1");
+    return false;
   }
 
   // `inertia = {I1, I2, I3}` (principal moments) stays `inertia`; a matrix becomes Icm.
