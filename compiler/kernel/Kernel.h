@@ -99,6 +99,14 @@ void printProgram(std::ostream& os, const Program& p, const KernelModule& m);
 /// "file.qd:12" for a range, "" if it has no location.
 std::string describeLocation(const SourceManager& sm, SourceRange r);
 
+/// What breaks the loop rules in `p` (loop structure, indices looped instructions reach at their
+/// loop's smallest and largest offsets, operands that are not earlier registers or are defined in
+/// another loop's body), "" if nothing. `variableCount`: the length of y and y'.
+std::string checkLoops(const Program& p, size_t variableCount);
+
+/// Instructions one run of `p` executes: a loop body's count times, the rest once.
+uint64_t executedInstructions(const Program& p);
+
 /// Reference interpreter of the kernel IR (tests and debugging; the VM is the fast path).
 /// out.size() must be >= p.outputCount.
 void interpret(const Program& p, const ModelCall& in, std::span<double> out);

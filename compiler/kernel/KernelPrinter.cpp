@@ -84,7 +84,7 @@ std::string describeLocation(const SourceManager& sm, SourceRange r) {
 void printProgram(std::ostream& os, const Program& prog, const KernelModule& m) {
   os << "\nfunction " << prog.name << ": " << prog.outputCount << " outputs, " << prog.code.size()
      << " instructions, " << prog.constants.size() << " constants";
-  if (!prog.loops.empty()) os << ", " << prog.loops.size() << " loops";
+  if (!prog.loops.empty()) os << ", " << prog.loops.size() << " loops (" << executedInstructions(prog) << " instructions per run)";
   os << "\n";
   if (!prog.indexTable.empty()) os << "  X =";
   for (uint32_t x : prog.indexTable) os << " " << x;

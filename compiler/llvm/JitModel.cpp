@@ -52,13 +52,16 @@ struct JitModel : AdaptedModel {
   }
 };
 
-// The sizes the ABI relies on (a malformed module would make compiled code write out of bounds).
+// The sizes the ABI relies on and the loop rules (a malformed module would make compiled code
+// write out of bounds).
 Status validate(const kernel::KernelModule& k) {
   for (size_t i = 0; i < kModelProgramCount; ++i) {
     size_t expected = k.description.outputCount(programAt(i));
     if (k.programs[i].outputCount != expected)
       return Error{"kernel program " + k.programs[i].name + " writes " + std::to_string(k.programs[i].outputCount) +
                    " values, the model ABI expects " + std::to_string(expected)};
+    if (std::string e = kernel::checkLoops(k.programs[i], k.variableCount()); !e.empty())
+      return Error{"kernel program " + k.programs[i].name + ": " + e};
   }
   if (std::string e = k.description.inconsistency(); !e.empty()) return Error{"kernel module: " + e};
   return {};

@@ -103,5 +103,34 @@ TEST_F(LoopLowering, CountZeroAndOne) {
   }
 }
 
+// checkLoops (what the JIT relies on) accepts the builder's loops and names each broken rule;
+// executedInstructions counts a body once per iteration.
+TEST_F(LoopLowering, CheckLoopsAndExecutedInstructions) {
+  auto build = [&](uint32_t count, int32_t first) {
+    kernel::ProgramBuilder b("residual");
+    b.bindLoopedLoad(here, Op::LoadYLooped, 1);
+    b.beginLoop(kernel::Loop{.count = count, .first = first, .stride = 1});
+    b.storeLooped(0, b.lower(ctx.mul(c(2), here)));
+    b.endLoop();
+    return b.finish(4);
+  };
+  kernel::Program p = build(3, 0);  // y[1 + L], L = 0..2: y[1..3]; out[0..2]
+  EXPECT_EQ(kernel::checkLoops(p, 4), "");
+  EXPECT_EQ(kernel::executedInstructions(p), 2 + 3u * 4);  // loop, endloop; 3 x (ldk, ldyl, mul, stl)
+  EXPECT_NE(kernel::checkLoops(build(4, 0), 4).find("ldyl index out of range"), std::string::npos);  // y[4]
+  EXPECT_NE(kernel::checkLoops(build(3, -2), 4).find("index out of range"), std::string::npos);      // y[-1]
+  EXPECT_EQ(kernel::checkLoops(build(0, -9), 4), "");  // no iteration reaches anything
+  kernel::Program escaped = p;
+  escaped.code.push_back({Op::Store, 3, 0, 0, 3});  // %3 (the mul, in the body) after the loop
+  EXPECT_NE(kernel::checkLoops(escaped, 4).find("is read outside it"), std::string::npos);
+  kernel::Program outside = p;
+  outside.code.push_back({Op::LoadLoopOffset});
+  EXPECT_NE(kernel::checkLoops(outside, 4).find("ldidx outside a loop"), std::string::npos);
+  kernel::Program nested = p;
+  nested.loops.push_back(nested.loops[0]);
+  nested.code.insert(nested.code.begin() + 1, {Op::LoopBegin, 0, 0, 0, 1});
+  EXPECT_NE(kernel::checkLoops(nested, 4).find("nested loop"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace qdot::test
