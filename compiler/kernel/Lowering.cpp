@@ -8,6 +8,8 @@
 #include <cmath>
 #include <limits>
 
+#include "support/Assert.h"
+
 namespace qdot::kernel {
 namespace {
 
@@ -105,6 +107,7 @@ void ProgramBuilder::setSymbolRegister(sym::Expr symbol, uint32_t reg) {
 }
 
 uint32_t ProgramBuilder::beginLoop(const Loop& loop) {
+  QDOT_ASSERT(!inLoop_, "loops do not nest");
   auto id = static_cast<uint32_t>(program_.loops.size());
   program_.loops.push_back(loop);
   emit(Op::LoopBegin, 0, 0, 0, id);
@@ -113,6 +116,7 @@ uint32_t ProgramBuilder::beginLoop(const Loop& loop) {
 }
 
 void ProgramBuilder::endLoop() {
+  QDOT_ASSERT(inLoop_, "endLoop without beginLoop");
   emit(Op::LoopEnd, 0, 0, 0, static_cast<uint32_t>(program_.loops.size() - 1));
   inLoop_ = false;
   for (auto it = bodySymbols_.rbegin(); it != bodySymbols_.rend(); ++it) symbolRegs_[it->first] = it->second;

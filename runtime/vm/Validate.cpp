@@ -10,13 +10,13 @@
 namespace qdot::bc {
 namespace {
 
-// Which inputs each entry point passes (qdot/programs.def).
 // The opcodes that use the loop state (c, L), allowed only inside a loop body.
 bool isLooped(Opcode op) {
   return op == Opcode::LoadYLooped || op == Opcode::LoadYpLooped || op == Opcode::LoadLoopOffset ||
          op == Opcode::StoreLooped || op == Opcode::StoreIndexed;
 }
 
+// Which inputs each entry point passes (qdot/programs.def).
 bool loadAllowed(ModelProgram program, Opcode op) {
   uint32_t inputs = programInputs(program);
   switch (op) {

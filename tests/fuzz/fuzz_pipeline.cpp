@@ -34,12 +34,13 @@ void checkDiagnostics(const driver::Compilation& c, size_t size) {
 }
 
 // Instruction i defines register %i and reads only earlier registers; each program writes what the
-// description says it writes.
+// description says it writes and keeps the loop rules.
 void checkKernels(const kernel::KernelModule& m, size_t unknowns) {
   check(m.variableCount() == unknowns && m.description.inconsistency().empty());
   for (size_t p = 0; p < kModelProgramCount; ++p) {
     const kernel::Program& program = m.programs[p];
     check(program.outputCount == m.description.outputCount(programAt(p)));
+    check(kernel::checkLoops(program, m.variableCount()).empty());
     for (uint32_t i = 0; i < program.code.size(); ++i) {
       const kernel::Instr& ins = program.code[i];
       uint32_t reads = kernel::readCount(ins.op);
