@@ -229,7 +229,7 @@ void ArkodeSession::Impl::createIntegrator() {
   check(ARKStepSetUserData(arkode, this), "ARKStepSetUserData");
   check(ARKStepSetTableNum(arkode, ARKODE_ESDIRK437L2SA_7_3_4, ARKODE_ERK_NONE), "ARKStepSetTableNum");
   tolerances = buildTolerances(options.rtol, options.atol, {data(y), n}, nominal, {model.isDifferential, n}, {},
-                               modelTimeScale(model, p, options.t0));
+                               options.atol ? TimeScale{} : modelTimeScale(model, p, options.t0));
   useCalibration(tolerances, kArkodeCalibration);  // measured for this method, as IDA's for BDF
   std::copy(tolerances.atol.begin(), tolerances.atol.end(), data(atol));
   check(ARKStepSVtolerances(arkode, tolerances.solverRtol, atol), "ARKStepSVtolerances");

@@ -330,7 +330,7 @@ void IdaSession::Impl::loadInitialValues() {
     failOutsideIda("the start values could not be computed", options.t0);
   }
   start.assign(data(y), data(y) + n);
-  timeScale = modelTimeScale(fullModel(), p, options.t0);
+  if (!options.atol) timeScale = modelTimeScale(fullModel(), p, options.t0);  // with --atol: no scales
   long bad = firstNonFinite(data(y), n);
   if (bad >= 0) {
     modelError = fmt::format("the start value of {} is {}", nameList(model.variableNames, n)[bad], data(y)[bad]);
