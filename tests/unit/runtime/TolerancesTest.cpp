@@ -7,6 +7,7 @@
 #include "HandModels.h"
 #include "ida/IdaSession.h"
 #include "ida/Tolerances.h"
+#include "arkode/StartLinearization.h"
 #include "sim/Simulation.h"
 
 namespace qdot::rt::test {
@@ -200,6 +201,31 @@ TEST(ToleranceVector, ArkodeCalibration) {
   useCalibration(w, kArkodeCalibration);
   EXPECT_EQ(w.solverRtol, 1e-6);
   EXPECT_EQ(w.atol[0], 1e-9);
+}
+
+// The lowest frequency of the linearization at the start, on m x'' + k x = 0 written as qdot does
+// (rows m v' + k x, x' − v; unknowns x, v): ω = sqrt(k/m). A spring of negative stiffness (a
+// growing mode) and none at all (a free mass: every eigenvalue zero) give no frequency.
+std::optional<double> oscillatorFrequency(double m, double k) {
+  auto residual = [=](const double* y, const double* yp, double* F) {
+    F[0] = m * yp[1] + k * y[0];
+    F[1] = yp[0] - y[1];
+  };
+  auto jacobian = [=](double cj, const double*, const double*, double* J) {  // column-major 2 x 2
+    J[0] = k, J[1] = cj;        // d/dx
+    J[2] = m * cj, J[3] = -1;   // d/dv
+  };
+  std::vector<double> y0 = {0.1, 0};
+  return lowestStartFrequency(y0, residual, jacobian);
+}
+
+TEST(StartLinearization, LowestFrequencyOfAnOscillator) {
+  ASSERT_TRUE(oscillatorFrequency(2, 50).has_value());
+  EXPECT_NEAR(*oscillatorFrequency(2, 50), 5.0, 1e-12);
+  EXPECT_FALSE(oscillatorFrequency(2, -50).has_value());  // saddle: released near an unstable equilibrium
+  EXPECT_FALSE(oscillatorFrequency(2, 0).has_value());    // a free mass
+  std::vector<std::complex<double>> modes = {{-1, 3}, {-1, -3}, {0, 1e6}, {0, -1e6}, {0, 0}};
+  EXPECT_NEAR(*lowestFrequency(modes), std::sqrt(10.0), 1e-12);  // |λ|, the zero (rigid) mode left out
 }
 
 }  // namespace
