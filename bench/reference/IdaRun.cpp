@@ -1,9 +1,12 @@
 // simulateReference: SUNDIALS IDA 6.4 over a hand-written ReferenceModel, call for call what
-// qdot's runtime does — IDAInit, per-variable atol (qdot's rule, rt::buildTolerances), IDASetId,
+// qdot's runtime does — IDAInit, per-variable atol (qdot's rule, rt::buildTolerances, with the
+// velocities' time scale from this program's own linearization at the start), IDASetId,
 // IDASetMaxNumSteps, dense or KLU with the analytic Jacobian, IDACalcIC(IDA_YA_YDP_INIT) towards
 // the first output time when F(y0, y'0) != 0 followed by IDAReInit and rebuilt tolerances,
 // IDASetStopTime, then IDASolve(IDA_NORMAL) to each output time with a CSV row after each.
 #include "reference/IdaRun.h"
+
+#include "arkode/StartLinearization.h"
 
 #include <ida/ida.h>
 #include <ida/ida_ls.h>
@@ -20,6 +23,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -104,6 +108,8 @@ class Integrator {
 
  private:
   void applyTolerances();
+  rt::TimeScale timeScale() const;
+  void denseJacobian(double cj, const double* y, const double* yp, double* J) const;
   void attachLinearSolver();
   static int residual(sunrealtype t, N_Vector y, N_Vector yp, N_Vector F, void* self);
   static int jacobian(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector yp, N_Vector F, SUNMatrix J, void* self,
@@ -118,6 +124,7 @@ class Integrator {
   SUNMatrix matrix_ = nullptr;
   SUNLinearSolver solver_ = nullptr;
   rt::ToleranceVector tolerances_;
+  std::optional<rt::TimeScale> timeScale_;  ///< computed once, from the start values, as qdot does
   bool calcIC_ = false;
 };
 
@@ -150,11 +157,37 @@ Integrator::~Integrator() {
   if (context_) SUNContext_Free(&context_);
 }
 
+// qdot's time scale for the velocities' automatic scales (runtime/arkode/StartLinearization.h), from
+// this program's own residual and Jacobian at the start values: the same rule, not qdot's numbers.
+rt::TimeScale Integrator::timeScale() const {
+  if (settings_.atol) return {};
+  std::vector<std::string> names = model_.variableNames();
+  std::vector<const char*> pointers;
+  for (const std::string& name : names) pointers.push_back(name.c_str());
+  rt::TimeScale scale{0.0, rt::velocityPositions(pointers)};
+  auto residual = [&](const double* y, const double* yp, double* F) { model_.residual(y, yp, F); };
+  auto jacobian = [&](double cj, const double* y, const double* yp, double* J) { denseJacobian(cj, y, yp, J); };
+  std::vector<double> y0 = model_.startValues();
+  scale.frequency = rt::lowestStartFrequency(y0, residual, jacobian).value_or(0.0);
+  return scale;
+}
+
+// J = dF/dy + cj dF/dy' column-major n × n into a zeroed J, from the dense or the sparse form.
+void Integrator::denseJacobian(double cj, const double* y, const double* yp, double* J) const {
+  if (!model_.sparse()) return model_.denseJacobian(cj, y, yp, J);
+  std::vector<int64_t> starts(n_ + 1), rows(model_.jacobianNonzeros());
+  std::vector<double> values(model_.jacobianNonzeros());
+  model_.sparseJacobian(cj, y, yp, starts.data(), rows.data(), values.data());
+  for (sunindextype c = 0; c < n_; ++c)
+    for (int64_t k = starts[c]; k < starts[c + 1]; ++k) J[c * n_ + rows[k]] = values[k];
+}
+
 void Integrator::applyTolerances() {
   std::vector<double> nominal(n_, 0.0);  // the models give no nominal values
   std::vector<int32_t> differential(n_, 1);
+  if (!timeScale_) timeScale_ = timeScale();
   tolerances_ = rt::buildTolerances(settings_.rtol, settings_.atol, {data(y_), static_cast<std::size_t>(n_)}, nominal,
-                                    differential);
+                                    differential, {}, *timeScale_);
   std::copy(tolerances_.atol.begin(), tolerances_.atol.end(), data(atol_));
   // qdot's solver rtol (calibrated without --atol, runtime/ida/Tolerances.h): the same IDA settings
   check(IDASVtolerances(ida_, tolerances_.solverRtol, atol_), "IDASVtolerances");

@@ -18,6 +18,7 @@
 #include <Eigen/Dense>
 
 #include "arkode/ExplicitForm.h"
+#include "arkode/StartLinearization.h"
 #include "ida/ModelCheck.h"
 
 namespace qdot::rt {
@@ -227,10 +228,11 @@ void ArkodeSession::Impl::createIntegrator() {
   check(ARKStepSetErrHandlerFn(arkode, &Impl::errorCallback, this), "ARKStepSetErrHandlerFn");
   check(ARKStepSetUserData(arkode, this), "ARKStepSetUserData");
   check(ARKStepSetTableNum(arkode, ARKODE_ESDIRK437L2SA_7_3_4, ARKODE_ERK_NONE), "ARKStepSetTableNum");
-  tolerances = buildTolerances(options.rtol, options.atol, {data(y), n}, nominal, {model.isDifferential, n});
-  useAsGiven(tolerances);  // the rtol calibration is measured for IDA's BDF, not for this method
+  tolerances = buildTolerances(options.rtol, options.atol, {data(y), n}, nominal, {model.isDifferential, n}, {},
+                               options.atol ? TimeScale{} : modelTimeScale(model, p, options.t0));
+  useCalibration(tolerances, kArkodeCalibration);  // measured for this method, as IDA's for BDF
   std::copy(tolerances.atol.begin(), tolerances.atol.end(), data(atol));
-  check(ARKStepSVtolerances(arkode, options.rtol, atol), "ARKStepSVtolerances");
+  check(ARKStepSVtolerances(arkode, tolerances.solverRtol, atol), "ARKStepSVtolerances");
   check(ARKStepSetMaxNumSteps(arkode, options.maxStepsPerOutput), "ARKStepSetMaxNumSteps");
   // The Newton matrix I − γ dg/dy is rebuilt at every step. With ARKODE's default (every 20 steps,
   // or when γ changed by 20 %) the damped oscillator at rtol 1e-9 accepted steps whose Newton
@@ -320,14 +322,14 @@ int ArkodeSession::Impl::project(double time, N_Vector yv) {
   Eigen::Map<const Eigen::VectorXd> target(invariantsAtStart.data(), m);
   Eigen::VectorXd values, shifted, weight(n);
   for (uint32_t i = 0; i < n; ++i)
-    weight[i] = std::pow(options.rtol * std::abs(state[i]) + tolerances.atol[i], 2);
+    weight[i] = std::pow(tolerances.solverRtol * std::abs(state[i]) + tolerances.atol[i], 2);
   for (int iteration = 0; iteration < 3; ++iteration) {
     if (!invariantValues(time, state.data(), values)) return onFailure();
     Eigen::VectorXd defect = values - target;
     if (defect.cwiseAbs().maxCoeff() <= 4 * DBL_EPSILON * target.cwiseAbs().maxCoeff()) break;
     Eigen::MatrixXd gradient(m, n);
     for (uint32_t j = 0; j < n; ++j) {
-      double saved = state[j], h = std::sqrt(DBL_EPSILON) * std::max(std::abs(saved), std::sqrt(weight[j]) / options.rtol);
+      double saved = state[j], h = std::sqrt(DBL_EPSILON) * std::max(std::abs(saved), std::sqrt(weight[j]) / tolerances.solverRtol);
       state[j] = saved + h;
       bool ok = invariantValues(time, state.data(), shifted);
       state[j] = saved;

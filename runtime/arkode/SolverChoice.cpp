@@ -1,15 +1,14 @@
-// chooseSolver: eigenvalues of dg/dy = −A⁻¹ F_y at the start values (Eigen's dense EigenSolver).
+// chooseSolver: from the eigenvalues of dg/dy = −A⁻¹ F_y at the start values (StartLinearization.h).
 #include "arkode/SolverChoice.h"
 
 #include <fmt/format.h>
-
-#include <Eigen/Eigenvalues>
 
 #include <cmath>
 #include <complex>
 #include <vector>
 
 #include "arkode/ExplicitForm.h"
+#include "arkode/StartLinearization.h"
 
 namespace qdot::rt {
 
@@ -32,20 +31,6 @@ std::optional<SolverKind> parseSolver(std::string_view text) {
 }
 
 namespace {
-
-/// The eigenvalues of dg/dy at the start, or nullopt when the model cannot be evaluated there.
-std::optional<Eigen::VectorXcd> startEigenvalues(const QdotModel& model, std::span<const double> p, double start) {
-  uint32_t n = model.nVariables;
-  std::vector<double> y(n, 0.0), yp(n, 0.0), nominal(n, 0.0);
-  if (model.initialValues(&model, p.data(), start, y.data(), yp.data(), nominal.data()) != 0) return std::nullopt;
-  ExplicitForm form(model, p, false);
-  Eigen::MatrixXd jacobian;
-  if (form.rhs(start, y.data(), yp.data()) || form.denseJacobian(start, y.data(), yp.data(), jacobian))
-    return std::nullopt;
-  Eigen::EigenSolver<Eigen::MatrixXd> solver(jacobian, false);
-  if (solver.info() != Eigen::Success) return std::nullopt;
-  return solver.eigenvalues();
-}
 
 std::string ida(std::string why) { return "chose ida: " + why; }
 

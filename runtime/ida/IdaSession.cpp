@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "arkode/StartLinearization.h"
 #include "ida/DummyDerivatives.h"
 #include "ida/IdaFlags.h"
 #include "ida/InitialSystem.h"
@@ -97,6 +98,7 @@ struct IdaSession::Impl {
   std::vector<sunindextype> columnStarts, rowIndices;  // the CSC pattern in SUNDIALS' index type
   std::vector<double> jacobianValues;                  // dense only: values before scattering
   ToleranceVector tolerances;
+  TimeScale timeScale;  ///< the velocities' time scale, from the linearization at the start
   double t;
   double tout = 0;
   bool calcIC = false;
@@ -328,6 +330,7 @@ void IdaSession::Impl::loadInitialValues() {
     failOutsideIda("the start values could not be computed", options.t0);
   }
   start.assign(data(y), data(y) + n);
+  if (!options.atol) timeScale = modelTimeScale(fullModel(), p, options.t0);  // with --atol: no scales
   long bad = firstNonFinite(data(y), n);
   if (bad >= 0) {
     modelError = fmt::format("the start value of {} is {}", nameList(model.variableNames, n)[bad], data(y)[bad]);
@@ -349,7 +352,8 @@ void IdaSession::Impl::createIntegrator() {
 // relative to them (tighter weights made the line search fail on constrained models); the run
 // itself uses the calibrated ones (Tolerances.h).
 void IdaSession::Impl::applyTolerances(bool calibrated) {
-  tolerances = buildTolerances(options.rtol, options.atol, {data(y), n}, nominal, {model.isDifferential, n}, start);
+  tolerances = buildTolerances(options.rtol, options.atol, {data(y), n}, nominal, {model.isDifferential, n}, start,
+                               timeScale);
   if (!calibrated) useAsGiven(tolerances);
   std::copy(tolerances.atol.begin(), tolerances.atol.end(), data(atol));
   check(IDASVtolerances(ida, tolerances.solverRtol, atol), "IDASVtolerances");

@@ -1,11 +1,12 @@
 // Per-variable absolute tolerances: the user's atol as given (times nominal), or automatic scales
 // from nominal values or the start values, grouped by kind (differential / algebraic) so a zero
-// start value gets a floor tied to its neighbours. The rule is documented in Tolerances.h and
-// docs/accuracy.md.
+// start value gets a floor tied to its neighbours, and velocities from the model's time scale. The
+// rule is documented in Tolerances.h and docs/accuracy.md.
 #include "ida/Tolerances.h"
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_map>
 
 namespace qdot::rt {
 namespace {
@@ -36,6 +37,21 @@ double floorFor(double kindLargest, double allLargest) {
   return kAutomaticScaleFloorFactor * (kindCounts ? kindLargest : allLargest);
 }
 
+/// Whether unknown i is a velocity whose automatic scale follows the time scale.
+bool followsTimeScale(const TimeScale& timeScale, std::span<const double> nominal, std::size_t i) {
+  return timeScale.frequency > 0 && std::isfinite(timeScale.frequency) && i < timeScale.positionOf.size() &&
+         timeScale.positionOf[i] >= 0 && !hasNominal(nominal[i]);
+}
+
+/// The automatic tolerances with another solver rtol (atol_i = solverRtol * scale_i throughout).
+void rescale(ToleranceVector& t, double solverRtol) {
+  ToleranceSummary& s = t.summary;
+  double factor = solverRtol / t.solverRtol;
+  for (double& a : t.atol) a *= factor;
+  s.atolMin *= factor, s.atolMedian *= factor, s.atolMax *= factor;
+  s.atolUser = t.solverRtol = s.solverRtol = solverRtol;
+}
+
 double median(std::vector<double> values) {
   if (values.empty()) return 0;
   auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
@@ -48,12 +64,26 @@ double median(std::vector<double> values) {
 
 }  // namespace
 
-double calibratedRtol(double rtol) {
-  return std::max(kCalibrationFactor * std::pow(rtol, kCalibrationExponent), std::min(rtol, kSolverRtolFloor));
+double calibratedRtol(double rtol, const RtolCalibration& c) {
+  return std::max(c.factor * std::pow(rtol, c.exponent), std::min(rtol, c.floor));
+}
+
+std::vector<int32_t> velocityPositions(std::span<const char* const> names) {
+  std::unordered_map<std::string_view, int32_t> index;
+  for (std::size_t i = 0; i < names.size(); ++i) index.emplace(names[i], static_cast<int32_t>(i));
+  std::vector<int32_t> positionOf(names.size(), -1);
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    std::string_view name = names[i];
+    if (name.size() < 6 || !name.starts_with("der(") || !name.ends_with(")")) continue;
+    auto found = index.find(name.substr(4, name.size() - 5));
+    if (found != index.end()) positionOf[i] = found->second;
+  }
+  return positionOf;
 }
 
 std::vector<double> toleranceScales(std::span<const double> y, std::span<const double> nominal,
-                                    std::span<const int32_t> isDifferential, std::span<const double> start) {
+                                    std::span<const int32_t> isDifferential, std::span<const double> start,
+                                    const TimeScale& timeScale) {
   if (start.empty()) start = y;
   double all = largestMagnitude(start, nominal, isDifferential, -1);
   double floors[2] = {floorFor(largestMagnitude(start, nominal, isDifferential, 0), all),
@@ -66,18 +96,25 @@ std::vector<double> toleranceScales(std::span<const double> y, std::span<const d
       scales[i] = std::max(magnitude(y[i], 0.0), floors[isDifferential[i] != 0 ? 1 : 0]);
     }
   }
+  // Velocities after their positions: scale_q is final above (a position is never itself der(...)
+  // of another unknown in a mechanics model; if it were, it keeps the value computed above).
+  for (std::size_t i = 0; i < y.size(); ++i)
+    if (followsTimeScale(timeScale, nominal, i))
+      scales[i] = std::max(scales[i], scales[timeScale.positionOf[i]] * timeScale.frequency);
   return scales;
 }
 
 ToleranceVector buildTolerances(double rtol, std::optional<double> atol, std::span<const double> y,
                                 std::span<const double> nominal, std::span<const int32_t> isDifferential,
-                                std::span<const double> start) {
+                                std::span<const double> start, const TimeScale& timeScale) {
   ToleranceVector result;
   if (atol) {
     result.scale.resize(y.size());
     for (std::size_t i = 0; i < y.size(); ++i) result.scale[i] = hasNominal(nominal[i]) ? nominal[i] : 1.0;
   } else {
-    result.scale = toleranceScales(y, nominal, isDifferential, start);
+    result.scale = toleranceScales(y, nominal, isDifferential, start, timeScale);
+    for (std::size_t i = 0; i < y.size(); ++i) result.summary.velocities += followsTimeScale(timeScale, nominal, i);
+    if (result.summary.velocities > 0) result.summary.frequency = timeScale.frequency;
   }
   result.solverRtol = atol ? rtol : calibratedRtol(rtol);
   double base = atol.value_or(result.solverRtol);  // automatic: the calibrated rtol, relative and absolute alike
@@ -106,12 +143,12 @@ ToleranceVector buildTolerances(double rtol, std::optional<double> atol, std::sp
 }
 
 void useAsGiven(ToleranceVector& t) {
-  ToleranceSummary& s = t.summary;
-  if (s.atolGiven || t.solverRtol >= s.rtol) return;
-  double relaxed = s.rtol / t.solverRtol;
-  for (double& a : t.atol) a *= relaxed;
-  s.atolMin *= relaxed, s.atolMedian *= relaxed, s.atolMax *= relaxed;
-  s.atolUser = t.solverRtol = s.solverRtol = s.rtol;
+  if (t.summary.atolGiven || t.solverRtol >= t.summary.rtol) return;
+  rescale(t, t.summary.rtol);
+}
+
+void useCalibration(ToleranceVector& t, const RtolCalibration& calibration) {
+  if (!t.summary.atolGiven) rescale(t, calibratedRtol(t.summary.rtol, calibration));
 }
 
 }  // namespace qdot::rt

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <string_view>
 #include <vector>
 
 namespace qdot::rt {
@@ -24,7 +25,20 @@ struct ToleranceSummary {
   double atolMax = 0;         ///< largest atol_i
   std::size_t count = 0;      ///< number of unknowns
   std::size_t automatic = 0;  ///< unknowns without a nominal value (scale automatic, or 1 with --atol)
+  double frequency = 0;       ///< the model's lowest linearized frequency [1/s] the velocities follow; 0: none
+  std::size_t velocities = 0; ///< automatic velocity scales that follow it (position scale x frequency)
 };
+
+/// The model's time scale, for the scales of its velocities: a velocity v = der(q) of a position
+/// of scale s_q moves at about s_q * frequency in the model's slowest mode (a pendulum's angle of
+/// 1 rad at sqrt(g/l)), whatever the start values — which are often 0 for velocities.
+struct TimeScale {
+  double frequency = 0;              ///< lowest nonzero |eigenvalue| of the linearization at the start [1/s]; 0: none
+  std::vector<int32_t> positionOf;   ///< per unknown: the index of q when it is der(q), else -1 (empty: none)
+};
+
+/// positionOf for a TimeScale: unknown i named "der(NAME)" is the velocity of the unknown NAME.
+std::vector<int32_t> velocityPositions(std::span<const char* const> names);
 
 /// The absolute tolerances handed to IDASVtolerances, their scales and the summary.
 struct ToleranceVector {
@@ -41,8 +55,18 @@ struct ToleranceVector {
 ///   forced oscillator at 1e-13, the car axis at 1.6e-12, and — with the simplified equations of
 ///   issue 14 — at 1e-11 from the consistent start of rtol 1e-10: Newton failures at t = 2.275).
 /// With --atol the user speaks SUNDIALS' language and both tolerances go to IDA as given.
-double calibratedRtol(double rtol);
+/// The calibration of one method: solverRtol = factor * rtol^exponent, not below min(rtol, floor).
+struct RtolCalibration {
+  double factor, exponent, floor;
+};
 inline constexpr double kCalibrationFactor = 0.5, kCalibrationExponent = 1.15, kSolverRtolFloor = 2e-11;
+inline constexpr RtolCalibration kIdaCalibration{kCalibrationFactor, kCalibrationExponent, kSolverRtolFloor};
+/// ARKODE's ESDIRK4(3)7L[2]SA, measured the same way (`qdot wp --solver arkode`, docs/accuracy.md):
+/// with rtol as given its global error grew as rtol^0.80…0.87 (error/rtol 32–2500 over 1e-3…1e-10
+/// on the damped oscillator, the double pendulum and the governor), so exponent 1.2 ≈ 1/0.84, and
+/// the factor brings error/rtol to about 1. Floor: below 1e-13 its Newton iteration stalls in round-off.
+inline constexpr RtolCalibration kArkodeCalibration{0.03, 1.2, 1e-13};
+double calibratedRtol(double rtol, const RtolCalibration& calibration = kIdaCalibration);
 
 /// The factor between the largest magnitude of a kind and the floor of an automatic scale.
 inline constexpr double kAutomaticScaleFloorFactor = 1e-3;
@@ -57,8 +81,12 @@ inline constexpr double kAutomaticScaleFloorFactor = 1e-3;
 /// ones after IDACalcIC): the floors come from what the model wrote, so roundoff such as 4e-13 left
 /// by IDACalcIC in a model that starts at rest cannot become a scale of 4e-16 (which made such a
 /// model fail at t = 0); a consistent value may only raise a scale. Empty `start`: start = y.
+/// A velocity v = der(q) without a nominal, given a time scale with frequency ω > 0, gets
+///   scale_v = max(|y_v|, floor_k, scale_q * ω)
+/// (the floor keeps a near-zero ω, a pendulum released at 90°, from making it tighter than before).
 std::vector<double> toleranceScales(std::span<const double> y, std::span<const double> nominal,
-                                    std::span<const int32_t> isDifferential, std::span<const double> start = {});
+                                    std::span<const int32_t> isDifferential, std::span<const double> start = {},
+                                    const TimeScale& timeScale = {});
 
 /// The tolerance vector with its summary. With atol: atol_i = atol * nominal_i for an unknown with
 /// a nominal, else atol (absolute), and rtol as given. Without: solverRtol = calibratedRtol(rtol)
@@ -66,11 +94,15 @@ std::vector<double> toleranceScales(std::span<const double> y, std::span<const d
 /// nominal, isDifferential (and start, if not empty) must agree.
 ToleranceVector buildTolerances(double rtol, std::optional<double> atol, std::span<const double> y,
                                 std::span<const double> nominal, std::span<const int32_t> isDifferential,
-                                std::span<const double> start = {});
+                                std::span<const double> start = {}, const TimeScale& timeScale = {});
 
 /// Undoes the calibration (no-op with --atol): solverRtol = rtol, automatic atol_i = rtol *
 /// scale_i, the summary to match. For IDACalcIC, a first step that fails at the calibrated
 /// tolerances, and ARKODE (the calibration is measured for IDA's BDF only).
 void useAsGiven(ToleranceVector& tolerances);
+
+/// Recalibrates automatic tolerances for another method (no-op with --atol): solverRtol =
+/// calibratedRtol(rtol, calibration), the automatic atol_i = solverRtol * scale_i, the summary to match.
+void useCalibration(ToleranceVector& tolerances, const RtolCalibration& calibration);
 
 }  // namespace qdot::rt

@@ -18,9 +18,14 @@ std::string toleranceText(const ToleranceSummary& t) {
   if (t.atolGiven)
     return fmt::format("rtol {:g}, atol {:g} absolute ({} of {} unknowns with a nominal: atol x nominal): {}", t.rtol,
                        t.atolUser, nominal, t.count, range);
-  return fmt::format("rtol {:g} (to IDA as {:.3g}, calibrated for the global error), atol = that x scale, {} of {} "
-                     "scales automatic (max(|value|, 1e-3 x largest start value of its kind); docs/accuracy.md): {}",
-                     t.rtol, t.solverRtol, t.automatic, t.count, range);
+  std::string velocities =
+      t.velocities == 0 ? ""
+                        : fmt::format("; {} velocit{} at least position scale x {:.3g} 1/s, the lowest linearized "
+                                      "frequency at the start",
+                                      t.velocities, t.velocities == 1 ? "y" : "ies", t.frequency);
+  return fmt::format("rtol {:g} (to the solver as {:.3g}, calibrated for the global error), atol = that x scale, {} of {} "
+                     "scales automatic (max(|value|, 1e-3 x largest start value of its kind){}; docs/accuracy.md): {}",
+                     t.rtol, t.solverRtol, t.automatic, t.count, velocities, range);
 }
 
 }  // namespace

@@ -79,8 +79,8 @@ struct StiffForced {
   }
 };
 
-RunResult runStiffForced(double rtol, const std::vector<std::string>& extra = {}) {
-  std::vector<std::string> args = {"--solver", "arkode", "--rtol", num(rtol), "--stats"};
+RunResult runStiffForced(double rtol, const std::vector<std::string>& extra = {}, const std::string& solver = "arkode") {
+  std::vector<std::string> args = {"--solver", solver, "--rtol", num(rtol), "--stats"};
   args.insert(args.end(), extra.begin(), extra.end());
   return runQdot("examples/benchmarks/stiff_forced_oscillator.qd", args);
 }
@@ -97,57 +97,58 @@ TEST(StiffForcedOscillator, ArkodeFollowsTheClosedForm) {
       [&](double t) { return oscillationBound(rtol, s.amp, 2 * M_PI / s.w, t); });
 }
 
-// Step counts over the tolerance ladder grow at most 3× per decade of rtol (order 4: 1.8×; IDA
-// grows 10–30× per decade here because BDF of order > 2 is unstable near the imaginary axis).
-// Reference: the issue's acceptance figure. Runs rtol 1e-2 … 1e-5 (see the disabled test below).
-void expectLadder(const std::vector<double>& rtols) {
+// Step counts over the tolerance ladder grow at most 3× per decade of rtol, on both solvers.
+// Reference: the issue's acceptance figure (before velocities got their scale from the model's time
+// scale, IDA grew 10–30× per decade here and failed at rtol ≤ 1e-8, ARKODE 3.8–10× below 1e-5: the
+// velocity's tolerance, 1e-3 of the start position's nominal times rtol, lay below its round-off).
+// Measured: arkode 39, 59, 95, 171, 318, 591, 1158, 2308, 4667 steps at rtol 1e-2 … 1e-10; ida 222,
+// 357, 485, 777, 1221, 2246, 3155, 4434, 4484.
+void expectLadder(const std::string& solver, const std::vector<double>& rtols) {
   long previous = -1;
   for (double rtol : rtols) {
-    auto r = runStiffForced(rtol);
-    ASSERT_EQ(r.exitCode, 0) << "rtol " << rtol << ": " << r.log;
+    auto r = runStiffForced(rtol, {}, solver);
+    ASSERT_EQ(r.exitCode, 0) << solver << " rtol " << rtol << ": " << r.log;
     long steps = statistic(r, "steps");
-    std::cout << "[measured] rtol " << rtol << ": " << steps << " steps, solve " << solveSeconds(r) << " s\n";
-    if (previous > 0) EXPECT_LE(steps, 3 * previous) << "from rtol " << rtol * 10 << " to " << rtol;
+    std::cout << "[measured] " << solver << " rtol " << rtol << ": " << steps << " steps, solve " << solveSeconds(r)
+              << " s\n";
+    if (previous > 0) EXPECT_LE(steps, 3 * previous) << solver << " from rtol " << rtol * 10 << " to " << rtol;
     previous = steps;
   }
 }
 
-TEST(StiffForcedOscillator, StepsGrowAtMostThreefoldPerDecadeToRtol1e5) {
-  expectLadder({1e-2, 1e-3, 1e-4, 1e-5});
+TEST(StiffForcedOscillator, StepsGrowAtMostThreefoldPerDecadeToRtol1e10) {
+  const std::vector<double> ladder = {1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10};
+  expectLadder("arkode", ladder);
+  expectLadder("ida", ladder);
 }
 
-// Disabled until velocities get tolerance scales from the model's time scales (issue 11, section 2):
-// today the velocity's automatic scale is 1e-3 of the largest start position (1e-9 m/s here, while
-// ẋ is a small difference of 1e6 N forces: its round-off is about 1e-15 m/s), so at rtol ≤ 1e-8 its
-// tolerance lies below its round-off and the step count grows 3.8× (1e-5 → 1e-6), 5× and 6–10× per
-// decade (measured 3243 steps at 1e-5, then 14031, 73414, 431777 at 1e-6 … 1e-8; 1e-10 hits the
-// step limit). With the velocity's tolerance rtol × X·ω0 (= rtol × 1 m/s) the ladder measured 39,
-// 59, 95, 171, 318, 591, 1154, 2308, 4654 steps at rtol 1e-2 … 1e-10 (at most 1.9× per decade), and
-// rtol 1e-6 took 0.010 s of solve time against IDA's 10 s (today 0.27 s: 2.7 %).
-TEST(StiffForcedOscillator, DISABLED_StepsGrowAtMostThreefoldPerDecadeToRtol1e10) {
-  expectLadder({1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10});
+// At rtol 1e-6 over the first second, both solvers take under 1 % of the steps IDA took before the
+// velocity's tolerance followed the model's time scale. Reference: the issue's measurement, 3.4 M
+// steps over 10 s (467 118 over the first second on this build; 1.6 s of solve time). Work, not
+// time, is asserted (the times are in docs/accuracy.md). Measured: arkode 155, ida 1088 steps.
+TEST(StiffForcedOscillator, TakesUnderOnePercentOfTheStepsBefore) {
+  const long before = 467118;
+  for (const char* solver : {"arkode", "ida"}) {
+    auto r = runStiffForced(1e-6, {"--stop", "1"}, solver);
+    ASSERT_EQ(r.exitCode, 0) << r.log;
+    long steps = statistic(r, "steps");
+    std::cout << "[measured] " << solver << " " << steps << " steps, solve " << solveSeconds(r) << " s\n";
+    EXPECT_GT(steps, 0) << solver;
+    EXPECT_LT(steps, before / 100) << solver;
+  }
 }
 
-TEST(StiffForcedOscillator, DISABLED_ArkodeTakesUnderOnePercentOfIdasTime) {
-  auto ida = runQdot("examples/benchmarks/stiff_forced_oscillator.qd", {"--rtol", "1e-6", "--stop", "1", "--stats"});
-  auto arkode = runStiffForced(1e-6, {"--stop", "1"});
-  ASSERT_EQ(ida.exitCode, 0) << ida.log;
-  ASSERT_EQ(arkode.exitCode, 0) << arkode.log;
-  EXPECT_LT(solveSeconds(arkode), solveSeconds(ida) / 100);
-}
-
-// At rtol 1e-6 the L-stable method takes under 1 % of IDA's steps over the first second (IDA:
-// about 340 000 steps per simulated second, 3.4 M over 10 s). Reference: the issue's measurement.
-TEST(StiffForcedOscillator, ArkodeTakesUnderOnePercentOfIdasSteps) {
-  auto ida = runQdot("examples/benchmarks/stiff_forced_oscillator.qd", {"--rtol", "1e-6", "--stop", "1", "--stats"});
-  auto arkode = runStiffForced(1e-6, {"--stop", "1"});
-  ASSERT_EQ(ida.exitCode, 0) << ida.log;
-  ASSERT_EQ(arkode.exitCode, 0) << arkode.log;
-  long idaSteps = statistic(ida, "steps"), arkodeSteps = statistic(arkode, "steps");
-  std::cout << "[measured] ida " << idaSteps << " steps, solve " << solveSeconds(ida) << " s; arkode " << arkodeSteps
-            << " steps, solve " << solveSeconds(arkode) << " s\n";
-  EXPECT_GT(idaSteps, 100000);
-  EXPECT_LT(arkodeSteps, idaSteps / 100);
+// IDA follows the closed form too, now that the velocity's tolerance is rtol·X·ω0 (BDF drops to the
+// stable orders where it must; before, the velocity's tolerance below its round-off made every step
+// fail the error test). Bound as for ARKODE above; measured error/bound 5e-4 at rtol 1e-6.
+TEST(StiffForcedOscillator, IdaFollowsTheClosedForm) {
+  const StiffForced s;
+  const double rtol = 1e-6;
+  auto r = runStiffForced(rtol, {}, "ida");
+  ASSERT_EQ(r.exitCode, 0) << r.log;
+  compareColumn(
+      r, "x", [&](double t) { return s.x(t); },
+      [&](double t) { return oscillationBound(rtol, s.amp, 2 * M_PI / s.w, t); });
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -253,11 +254,12 @@ TEST(DoublePendulum, TrajectoryConvergesUpToTenSeconds) {
 
 // Lengths of 1e-9 m and 1e6 m give the same nondimensional answer θ(τ), τ = t √(g/l), at the same
 // step count (models/pendulum.qd, θ0 = 1, ten time units, 500 rows). Reference: the unit pendulum;
-// the equation θ'' + sin θ = 0 in τ has no length in it. Disabled until velocity tolerances follow
-// the model's time scales (issue 11, section 2): today a velocity's automatic scale is 1e-3 of the
-// largest start value whatever l, so IDA takes 230, 202 and 151 steps (arkode 59, 55, 46) for
-// l = 1e-9, 1 and 1e6, and θ(τ) differs by 3e-6 to 1.7e-5 rad at rtol 1e-6.
-TEST(Pendulum, DISABLED_LengthScaleDoesNotChangeTheNondimensionalRun) {
+// the equation θ'' + sin θ = 0 in τ has no length in it. It holds because the velocity's automatic
+// scale is θ's scale times the lowest linearized frequency √(g cos θ0 / l) (docs/accuracy.md):
+// the same step count for every l on both solvers, θ(τ) equal to within the Newton iterations'
+// stopping test (measured 5e-14 rad on IDA, 7e-10 on ARKODE; bound 1e-2·rtol = 1e-8). Before, with
+// 1e-3 of the start angle as the velocity's scale whatever l, IDA took 230, 202 and 151 steps and θ(τ) differed by 3e-6 to 1.7e-5 rad.
+TEST(Pendulum, LengthScaleDoesNotChangeTheNondimensionalRun) {
   for (const char* solver : {"ida", "arkode"}) {
     std::vector<RunResult> runs;
     std::vector<long> steps;
@@ -271,8 +273,13 @@ TEST(Pendulum, DISABLED_LengthScaleDoesNotChangeTheNondimensionalRun) {
     }
     for (std::size_t k : {0u, 2u}) {
       EXPECT_EQ(steps[k], steps[1]) << solver;
+      ASSERT_EQ(runs[k].rows, runs[1].rows) << solver;
+      double difference = 0;
       for (std::size_t i = 0; i < runs[1].rows; ++i)
-        EXPECT_NEAR(runs[k].col("theta")[i], runs[1].col("theta")[i], 1e-12) << solver << " row " << i;
+        difference = std::max(difference, std::fabs(runs[k].col("theta")[i] - runs[1].col("theta")[i]));
+      std::cout << "[measured] " << solver << ": " << steps[k] << " steps against " << steps[1] << ", max |Δθ(τ)| "
+                << difference << " rad\n";
+      EXPECT_LE(difference, 1e-8) << solver;
     }
   }
 }

@@ -7,6 +7,7 @@
 #include "HandModels.h"
 #include "ida/IdaSession.h"
 #include "ida/Tolerances.h"
+#include "arkode/StartLinearization.h"
 #include "sim/Simulation.h"
 
 namespace qdot::rt::test {
@@ -161,6 +162,70 @@ TEST(ToleranceVector, CalibratedRtolOnlyWithoutAtol) {
   std::vector<int32_t> kind = {1, 1};
   EXPECT_EQ(buildTolerances(1e-6, std::nullopt, y0, std::vector<double>(2, 0.0), kind).solverRtol, calibratedRtol(1e-6));
   EXPECT_EQ(buildTolerances(1e-6, 1e-9, y0, std::vector<double>(2, 0.0), kind).solverRtol, 1e-6);
+}
+
+// A velocity der(q) is known by its name; its automatic scale is q's scale times the model's lowest
+// frequency (a pendulum: 1 rad at sqrt(g/l) = 3.13/s), never below the floor of its kind, and a
+// nominal still wins. Without a frequency the rule is the start-value one.
+TEST(ToleranceScales, VelocityFollowsItsPositionTimesTheLowestFrequency) {
+  std::vector<const char*> names = {"theta", "der(theta)", "x", "der(x)", "der(y)"};
+  EXPECT_EQ(velocityPositions(names), (std::vector<int32_t>{-1, 0, -1, 2, -1}));
+  std::vector<double> y0 = {1, 0, 2, 0, 0};
+  std::vector<double> nominal = {0, 0, 0, 0.5, 0};
+  std::vector<int32_t> kind = {1, 1, 1, 1, 1};
+  TimeScale pendulum{std::sqrt(9.81), velocityPositions(names)};
+  std::vector<double> s = toleranceScales(y0, nominal, kind, {}, pendulum);
+  EXPECT_DOUBLE_EQ(s[1], std::sqrt(9.81));  // 1 rad x 3.13/s
+  EXPECT_EQ(s[3], 0.5);                     // nominal wins
+  EXPECT_DOUBLE_EQ(s[4], 2e-3);             // no position of that name: the floor, 1e-3 x largest start
+  TimeScale slow{1e-6, velocityPositions(names)};
+  EXPECT_DOUBLE_EQ(toleranceScales(y0, nominal, kind, {}, slow)[1], 2e-3);  // not below the floor
+  EXPECT_DOUBLE_EQ(toleranceScales(y0, nominal, kind)[1], 2e-3);            // no time scale: as before
+  ToleranceVector v = buildTolerances(1e-6, std::nullopt, y0, nominal, kind, {}, pendulum);
+  EXPECT_EQ(v.summary.velocities, 1u);
+  EXPECT_DOUBLE_EQ(v.summary.frequency, std::sqrt(9.81));
+  EXPECT_DOUBLE_EQ(v.atol[1], v.solverRtol * std::sqrt(9.81));
+  EXPECT_EQ(buildTolerances(1e-6, 1e-9, y0, nominal, kind, {}, pendulum).atol[1], 1e-9);  // --atol: absolute
+}
+
+// ARKODE's calibration (measured with qdot wp) replaces IDA's, on the automatic atol only.
+TEST(ToleranceVector, ArkodeCalibration) {
+  std::vector<double> y0 = {1, 2};
+  std::vector<int32_t> kind = {1, 1};
+  ToleranceVector v = buildTolerances(1e-6, std::nullopt, y0, std::vector<double>(2, 0.0), kind);
+  useCalibration(v, kArkodeCalibration);
+  EXPECT_NEAR(v.solverRtol, 0.03 * std::pow(1e-6, 1.2), 1e-22);
+  EXPECT_DOUBLE_EQ(v.atol[1], 2 * v.solverRtol);
+  EXPECT_EQ(calibratedRtol(1e-12, kArkodeCalibration), 1e-13);  // the floor
+  ToleranceVector w = buildTolerances(1e-6, 1e-9, y0, std::vector<double>(2, 0.0), kind);
+  useCalibration(w, kArkodeCalibration);
+  EXPECT_EQ(w.solverRtol, 1e-6);
+  EXPECT_EQ(w.atol[0], 1e-9);
+}
+
+// The lowest frequency of the linearization at the start, on m x'' + k x = 0 written as qdot does
+// (rows m v' + k x, x' − v; unknowns x, v): ω = sqrt(k/m). A spring of negative stiffness (a
+// growing mode) and none at all (a free mass: every eigenvalue zero) give no frequency.
+std::optional<double> oscillatorFrequency(double m, double k) {
+  auto residual = [=](const double* y, const double* yp, double* F) {
+    F[0] = m * yp[1] + k * y[0];
+    F[1] = yp[0] - y[1];
+  };
+  auto jacobian = [=](double cj, const double*, const double*, double* J) {  // column-major 2 x 2
+    J[0] = k, J[1] = cj;        // d/dx
+    J[2] = m * cj, J[3] = -1;   // d/dv
+  };
+  std::vector<double> y0 = {0.1, 0};
+  return lowestStartFrequency(y0, residual, jacobian);
+}
+
+TEST(StartLinearization, LowestFrequencyOfAnOscillator) {
+  ASSERT_TRUE(oscillatorFrequency(2, 50).has_value());
+  EXPECT_NEAR(*oscillatorFrequency(2, 50), 5.0, 1e-12);
+  EXPECT_FALSE(oscillatorFrequency(2, -50).has_value());  // saddle: released near an unstable equilibrium
+  EXPECT_FALSE(oscillatorFrequency(2, 0).has_value());    // a free mass
+  std::vector<std::complex<double>> modes = {{-1, 3}, {-1, -3}, {0, 1e6}, {0, -1e6}, {0, 0}};
+  EXPECT_NEAR(*lowestFrequency(modes), std::sqrt(10.0), 1e-12);  // |λ|, the zero (rigid) mode left out
 }
 
 }  // namespace
