@@ -61,7 +61,14 @@ bool check(Compilation& c) {
 }
 
 bool flatten(Compilation& c) {
-  c.flat = timed(c.times.flatten, [&] { return flat::flatten(*c.checked, c.ctx, c.diags, c.options.limits, c.options.structural); });
+  c.flat = timed(c.times.flatten, [&] {
+    flat::FlattenLimits limits = c.options.limits;
+    limits.keepLoops = true;
+    auto model = flat::flatten(*c.checked, c.ctx, c.diags, limits, c.options.structural);
+    // The later stages do not take templates yet (issue 15, docs/loops.md): expanded here.
+    if (model) flat::expandIndexedSums(*model, c.ctx);
+    return model;
+  });
   return c.flat && !c.diags.hasErrors();
 }
 
