@@ -16,28 +16,22 @@ using sym::Expr;
 
 using Box = std::vector<std::pair<long, long>>;
 
-/// One summand of a row on a box of subscripts: ∂(body)/∂(x[%+o]) shifted by −o.
-struct Contribution {
-  int array = -1;  // the coordinates
-  Box box;
-  enum class Part { Momentum, Position, Dissipation } part = Part::Position;
-  Expr value = nullptr;
-};
-
 class TemplateDeriver {
  public:
   TemplateDeriver(const flat::FlatModel& m, sym::Context& ctx, const std::vector<char>& peeled,
                   sym::SimplifyLevel level)
       : m_(m), ctx_(ctx), patterns_(*m.patterns), peeled_(peeled), simplify_(ctx, level) {}
 
-  TemplateDerivation run() {
+  TemplateDerivation run(bool rows = true) {
     for (int s = 0; s < static_cast<int>(m_.indexedSums.size()); ++s)
       if (!contribute(m_.indexedSums[s])) out_.scalarSums.push_back(s);
+    if (!rows) return std::move(out_);
     std::vector<int> arrays;
     for (const Contribution& c : contributions_) arrays.push_back(c.array);
     std::sort(arrays.begin(), arrays.end());
     arrays.erase(std::unique(arrays.begin(), arrays.end()), arrays.end());
     for (int a : arrays) rowsOf(a);
+    out_.contributions = std::move(contributions_);
     return std::move(out_);
   }
 
@@ -196,7 +190,15 @@ class TemplateDeriver {
     std::vector<Expr> parts{timeDerivative(row.momentum), ctx_.neg(ctx_.add(position)), ctx_.add(dissipation)};
     Expr residual = ctx_.add(parts);
     row.residual = simplify_(residual);
+    if (!ctx_.dependsOn(row.residual, ownAcceleration(a))) return;  // no inertia of its own: scalar rows
     out_.rows.push_back(std::move(row));
+  }
+
+  // der(der(x))[%1, …, %rank]: a row that contains it determines its element's acceleration.
+  Expr ownAcceleration(int a) {
+    RelativeElement rel{derivativeArray(derivativeArray(a)), {}};
+    for (size_t d = 0; d < patterns_.arrays[a].shape.size(); ++d) rel.dims.push_back({static_cast<int>(d), 0});
+    return patterns_.symbol(ctx_, rel);
   }
 
   static bool contains(const Box& outer, const Box& inner) {
@@ -207,6 +209,11 @@ class TemplateDeriver {
 };
 
 }  // namespace
+
+std::vector<int> sumsWithoutTemplates(const flat::FlatModel& model, sym::Context& ctx) {
+  std::vector<char> none(model.variables.size(), 0);
+  return TemplateDeriver(model, ctx, none, sym::SimplifyLevel::None).run(false).scalarSums;
+}
 
 TemplateDerivation deriveTemplateRows(const flat::FlatModel& model, sym::Context& ctx, const std::vector<char>& peeled,
                                       sym::SimplifyLevel level) {

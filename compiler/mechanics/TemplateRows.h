@@ -31,13 +31,28 @@ struct TemplateRow {
   }
 };
 
+/// One summand of the rows of a coordinate array on a box of subscripts: the derivative of an
+/// IndexedSum's body by `x[%+o]` or `der(x)[%+o]`, shifted by −o (so %k is the row's subscript).
+struct Contribution {
+  int array = -1;  ///< the coordinates
+  std::vector<std::pair<long, long>> box;
+  enum class Part : uint8_t { Momentum, Position, Dissipation } part = Part::Position;  ///< ∂L/∂v, ∂L/∂q, ∂D/∂v
+  sym::Expr value = nullptr;
+};
+
 struct TemplateDerivation {
   std::vector<TemplateRow> rows;
+  /// Every contribution: the scalar rows of elements outside the rows' regions (peeled) add those
+  /// whose box contains them, instantiated there.
+  std::vector<Contribution> contributions;
   /// IndexedSums (indices into FlatModel::indexedSums) that cannot give template rows (a body
   /// coupling an element to a scalar coordinate, or indexing coordinates other than x[%1+o, %2+p]):
   /// the caller expands them into the scalar terms.
   std::vector<int> scalarSums;
 };
+
+/// The IndexedSums that cannot give template rows (TemplateDerivation::scalarSums).
+std::vector<int> sumsWithoutTemplates(const flat::FlatModel& model, sym::Context& ctx);
 
 /// Derives the template rows of model.indexedSums. `peeled` (by flat variable) marks coordinates
 /// that also occur in scalar terms, forces or constraints: their rows stay scalar.

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "unit/common/SourceDae.h"
+#include <algorithm>
 #include <cmath>
 
 #include "flatten/Flatten.h"
@@ -174,6 +175,32 @@ std::vector<mech::TemplateRow> expectRowsMatchScalarDerivation(const char* name,
       }
     }
   }
+  // The whole derivation with templates: template rows where the regions are, the scalar rows of
+  // the peeled elements (with the templates' contributions instantiated), each equal to the scalar one.
+  auto templated = mech::deriveEquationsOfMotion(*f.templated, s.ctx, s.diags);
+  EXPECT_TRUE(templated);
+  if (!templated) return t.rows;
+  EXPECT_EQ(templated->rows.size(), eom->rows.size());
+  EXPECT_EQ(templated->templateRows.size(), t.rows.size());
+  size_t viaTemplates = 0;
+  for (size_t r = 0; r < std::min(templated->rows.size(), eom->rows.size()); ++r) {
+    const auto& row = templated->rows[r];
+    EXPECT_EQ(f.templated->variables[row.coordinate].symbol, f.scalar->variables[eom->rows[r].coordinate].symbol);
+    sym::Expr value = row.residual;
+    if (row.templateRow >= 0) {
+      ++viaTemplates;
+      const mech::TemplateRow& tr = templated->templateRows[row.templateRow];
+      const flat::ArrayVariable& a = f.templated->patterns->arrays[tr.array];
+      size_t k = std::find(a.elements.begin(), a.elements.end(), f.templated->variables[row.coordinate].symbol) - a.elements.begin();
+      std::vector<long> point(a.shape.size());
+      for (size_t d = a.shape.size(); d-- > 0;) point[d] = static_cast<long>(k % a.shape[d]) + 1, k /= a.shape[d];
+      value = flat::instantiate(*f.templated, s.ctx, tr.residual, point);
+    }
+    values.resize(std::max(values.size(), s.ctx.symbolCount()), 0.5);
+    double expected = sym::evaluate(eom->rows[r].residual, values), got = sym::evaluate(value, values);
+    EXPECT_NEAR(got, expected, 1e-12 * (1 + std::abs(expected))) << "row " << r;
+  }
+  EXPECT_GT(viaTemplates, 0u);
   return t.rows;
 }
 
