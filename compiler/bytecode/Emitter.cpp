@@ -1,8 +1,12 @@
-// emitFunction: linear-scan register assignment over the kernel's straight-line SSA program.
-// Operands dying at an instruction are released before its result is assigned, so the result may
-// reuse an operand's register (VM handlers read operands first). `ldk` emits nothing: constants
-// live in registers [0, pool size), preloaded once by the VM.
+// emitFunction: linear-scan register assignment over the kernel's SSA program. Operands dying at
+// an instruction are released before its result is assigned, so the result may reuse an operand's
+// register (VM handlers read operands first). `ldk` emits nothing: constants live in registers
+// [0, pool size), preloaded once by the VM. A loop body runs again after its last instruction, so
+// a value from before the loop that the body reads lives until the `endloop`; the body's own values
+// are read only inside it, and their registers are reused as in straight-line code.
 #include "bytecode/Emitter.h"
+
+#include <unordered_map>
 
 #include "vm/Vm.h"
 
@@ -24,10 +28,21 @@ class Allocator {
  public:
   explicit Allocator(const kernel::Program& p) : p_(p), physical_(p.code.size(), kUnused), lastUse_(p.code.size(), kUnused) {
     next_ = static_cast<uint32_t>(p.constants.size());
+    uint32_t body = kUnused;  // first instruction of the open loop body
+    std::vector<uint32_t> outer;  // values from before the open loop that its body reads
     for (uint32_t i = 0; i < p.code.size(); ++i) {
       uint32_t ops[3];
-      for (uint32_t k = 0, n = operandsOf(p.code[i], ops); k < n; ++k) lastUse_[ops[k]] = i;
+      for (uint32_t k = 0, n = operandsOf(p.code[i], ops); k < n; ++k) {
+        lastUse_[ops[k]] = i;
+        if (body != kUnused && ops[k] < body) outer.push_back(ops[k]);
+      }
       if (p.code[i].op == kernel::Op::LoadConst) physical_[i] = p.code[i].imm;
+      if (p.code[i].op == kernel::Op::LoopBegin) body = i + 1;
+      if (p.code[i].op == kernel::Op::LoopEnd) {
+        for (uint32_t v : outer)
+          if (lastUse_[v] != i) lastUse_[v] = i, diesAtLoopEnd_[i].push_back(v);
+        outer.clear(), body = kUnused;
+      }
     }
   }
 
@@ -35,6 +50,8 @@ class Allocator {
     bc::Function f;
     f.constants = p_.constants;
     f.outputCount = p_.outputCount;
+    f.loops = p_.loops;
+    f.indexTable = p_.indexTable;
     for (uint32_t i = 0; i < p_.code.size(); ++i)
       if (p_.code[i].op != kernel::Op::LoadConst) encode(i, f);
     f.code.push_back(static_cast<uint32_t>(bc::Opcode::Ret));
@@ -64,7 +81,8 @@ class Allocator {
       if (lastUse_[ops[k]] == i && (k == 0 || ops[k] != ops[k - 1]) && (k < 2 || ops[k] != ops[0])) release(ops[k]);
     f.code.push_back(static_cast<uint32_t>(ins.op));
     f.sources.push_back(ins.source);
-    if (fmt == bc::Format::Store) {
+    if (bc::isLoopControl(fmt)) return encodeLoopControl(i, f);
+    if (bc::isStore(fmt)) {
       f.code.push_back(ins.imm), f.code.push_back(phys[0]);
       return;
     }
@@ -75,11 +93,28 @@ class Allocator {
     if (lastUse_[i] == kUnused) release(i);  // a value nobody reads
   }
 
+  // `loop l, exit` (exit: words from its opcode to after the endloop, patched there), `endloop l`.
+  void encodeLoopControl(uint32_t i, bc::Function& f) {
+    f.code.push_back(p_.code[i].imm);
+    if (p_.code[i].op == kernel::Op::LoopBegin) {
+      loopWord_ = f.code.size() - 2;
+      f.code.push_back(0);
+      return;
+    }
+    f.code[loopWord_ + 2] = static_cast<uint32_t>(f.code.size() - loopWord_);
+    if (auto it = diesAtLoopEnd_.find(i); it != diesAtLoopEnd_.end())
+      for (uint32_t v : it->second)
+        if (lastUse_[v] == i) release(v);
+  }
+
   const kernel::Program& p_;
   std::vector<uint32_t> physical_;  // value -> register
   std::vector<uint32_t> lastUse_;   // value -> last instruction reading it
   std::vector<uint32_t> free_;
   uint32_t next_ = 0;
+  std::unordered_map<uint32_t, std::vector<uint32_t>> diesAtLoopEnd_;  // endloop -> outer values it frees
+  size_t loopWord_ = 0;  // word of the open loop's opcode
+
 };
 
 }  // namespace

@@ -1,7 +1,9 @@
-// The kernel IR: backend-neutral straight-line programs computing what the model ABI asks for
-// (parameters, start values, residual F, Jacobian dF/dy + cj*dF/dy', outputs, invariants) from a
-// dae::Dae. Instructions are in SSA form over virtual registers and use the one opcode list of
+// The kernel IR: backend-neutral programs computing what the model ABI asks for (parameters, start
+// values, residual F, Jacobian dF/dy + cj*dF/dy', outputs, invariants) from a dae::Dae.
+// Instructions are in SSA form over virtual registers and use the one opcode list of
 // runtime/include/qdot/opcodes.def; every instruction names the equation (source) it serves.
+// Straight-line code except for loops (qdot/loop.hpp): `loop` … `endloop` runs its body once per
+// element of an index range, so repeated structure costs code once, not once per element.
 #pragma once
 
 #include <cstdint>
@@ -11,6 +13,7 @@
 #include <vector>
 
 #include "dae/Dae.h"
+#include "qdot/loop.hpp"
 #include "qdot/model_description.hpp"
 #include "qdot/programs.hpp"
 #include "support/SourceManager.h"
@@ -32,9 +35,17 @@ const char* mnemonic(Op op);
 /// How many of the operands a, b, c the opcode reads (its format's arity, qdot/bytecode.h).
 uint32_t readCount(Op op);
 
-/// One instruction. Instruction i of a program defines virtual register %i (SSA); `Store` and
-/// `Ret` define nothing. Operands a, b, c are earlier registers; `imm` is the input index for loads,
-/// the constant-pool index for `ldk`, the exponent (int32 bits) for `powi`, the output slot for `st`.
+/// A loop of a program: iterations c = 0 .. count-1; at iteration c the loop offset L is
+/// first + c*stride if offsetTable == kNoTable, else indexTable[offsetTable + c] (qdot/loop.hpp,
+/// shared with the bytecode).
+using qdot::Loop;
+
+/// One instruction. Instruction i of a program defines virtual register %i (SSA); stores, loop
+/// control and `Ret` define nothing. Operands a, b, c are earlier registers; `imm` is the input
+/// index for loads (ldyl, ldypl: added to L), the constant-pool index for `ldk`, the exponent
+/// (int32 bits) for `powi`, the output slot for `st` (stl: added to L), the index table position
+/// for `stx` (out[indexTable[imm + c]]), the loop id for `loop` and `endloop`. A register defined
+/// inside a loop body holds that iteration's value: it is read only inside the same body.
 struct Instr {
   Op op = Op::Ret;
   uint32_t a = 0, b = 0, c = 0;
@@ -42,12 +53,14 @@ struct Instr {
   uint32_t source = UINT32_MAX;  ///< index into KernelModule::sources (UINT32_MAX: none)
 };
 
-/// A straight-line program writing out[0, outputCount).
+/// A program writing out[0, outputCount): straight-line code and loops that do not nest.
 struct Program {
   std::string name;
   std::vector<Instr> code;
   std::vector<double> constants;  ///< the pool `ldk` reads (distinct bit patterns)
   uint32_t outputCount = 0;
+  std::vector<Loop> loops;            ///< by loop id
+  std::vector<uint32_t> indexTable;   ///< X: offsets of table loops, output slots of `stx`
 };
 
 /// What an instruction serves: an equation, an output, a parameter binding, a start value ...

@@ -33,6 +33,7 @@ std::string operands(const Instr& ins, const Program& prog, const KernelModule& 
     case bc::Format::None: return "";
     case bc::Format::Index: {
       if (ins.op == Op::LoadConst) return shortestText(prog.constants[ins.imm]);
+      if (ins.op == Op::LoadYLooped || ins.op == Op::LoadYpLooped) return std::to_string(ins.imm) + " + L";
       const auto* names = namesOfLoad(ins.op, m);
       return std::to_string(ins.imm) + (names && ins.imm < names->size() ? std::string(" (").append((*names)[ins.imm]) + ")" : "");
     }
@@ -41,6 +42,11 @@ std::string operands(const Instr& ins, const Program& prog, const KernelModule& 
     case bc::Format::Ternary: return reg(ins.a) + ", " + reg(ins.b) + ", " + reg(ins.c);
     case bc::Format::UnaryIndex: return reg(ins.a) + ", " + std::to_string(static_cast<int32_t>(ins.imm));
     case bc::Format::Store: return std::string("out[").append(std::to_string(ins.imm)) + "], " + reg(ins.a);
+    case bc::Format::StoreLooped: return std::string("out[").append(std::to_string(ins.imm)) + " + L], " + reg(ins.a);
+    case bc::Format::StoreIndexed: return std::string("out[X[").append(std::to_string(ins.imm)) + " + c]], " + reg(ins.a);
+    case bc::Format::LoopBegin:
+      return std::to_string(ins.imm) + (ins.imm < prog.loops.size() ? " (" + loopText(prog.loops[ins.imm]) + ")" : "");
+    case bc::Format::LoopEnd: return std::to_string(ins.imm);
   }
   return "";
 }
@@ -77,15 +83,24 @@ std::string describeLocation(const SourceManager& sm, SourceRange r) {
 
 void printProgram(std::ostream& os, const Program& prog, const KernelModule& m) {
   os << "\nfunction " << prog.name << ": " << prog.outputCount << " outputs, " << prog.code.size()
-     << " instructions, " << prog.constants.size() << " constants\n";
+     << " instructions, " << prog.constants.size() << " constants";
+  if (!prog.loops.empty()) os << ", " << prog.loops.size() << " loops";
+  os << "\n";
+  if (!prog.indexTable.empty()) os << "  X =";
+  for (uint32_t x : prog.indexTable) os << " " << x;
+  if (!prog.indexTable.empty()) os << "\n";
   uint32_t source = UINT32_MAX - 1;
+  const char* indent = "  ";  // deeper inside a loop body
   for (size_t i = 0; i < prog.code.size(); ++i) {
     const Instr& ins = prog.code[i];
-    if (ins.source != source && ins.source < m.sources.size()) os << "  ; " << m.sources[ins.source].label << "\n";
+    if (ins.source != source && ins.source < m.sources.size()) os << indent << "; " << m.sources[ins.source].label << "\n";
     source = ins.source;
-    std::string lhs = ins.op == Op::Store || ins.op == Op::Ret ? "" : std::string("%").append(std::to_string(i)) + " = ";
+    bool defines = bc::definesRegister(bc::info(static_cast<bc::Opcode>(ins.op)).format);
+    std::string lhs = defines ? std::string("%").append(std::to_string(i)) + " = " : "";
     std::string ops = operands(ins, prog, m);
-    os << "  " << lhs << mnemonic(ins.op) << (ops.empty() ? "" : " " + ops) << "\n";
+    if (ins.op == Op::LoopEnd) indent = "  ";
+    os << indent << lhs << mnemonic(ins.op) << (ops.empty() ? "" : " " + ops) << "\n";
+    if (ins.op == Op::LoopBegin) indent = "    ";
   }
 }
 

@@ -67,30 +67,64 @@ uint64_t ProgramBuilder::constantBits(double v) {
 
 uint32_t ProgramBuilder::constant(double v) {
   uint64_t bits = constantBits(v);
-  auto it = constants_.find(bits);
-  if (it != constants_.end()) return it->second;
-  auto index = static_cast<uint32_t>(program_.constants.size());
-  program_.constants.push_back(std::bit_cast<double>(bits));
-  uint32_t r = emit(Op::LoadConst, 0, 0, 0, index);
-  constants_.emplace(bits, r);
+  if (const uint32_t* r = knownConstant(bits)) return *r;
+  auto [pool, fresh] = pool_.try_emplace(bits, static_cast<uint32_t>(program_.constants.size()));
+  if (fresh) program_.constants.push_back(std::bit_cast<double>(bits));
+  uint32_t r = emit(Op::LoadConst, 0, 0, 0, pool->second);
+  (inLoop_ ? bodyConstants_ : constants_).emplace(bits, r);
   return r;
 }
 
-// Symbols by id, constants by value (the pool's own map: one `ldk` per bit pattern), other nodes in
-// the memo.
+// The register of a constant's `ldk` (outside loops the body's map is empty).
+const uint32_t* ProgramBuilder::knownConstant(uint64_t bits) const {
+  for (const auto* map : {&constants_, &bodyConstants_})
+    if (auto it = map->find(bits); it != map->end()) return &it->second;
+  return nullptr;
+}
+
+// Symbols by id, constants by value (one `ldk` per bit pattern and scope), other nodes in the memo.
 const uint32_t* ProgramBuilder::known(sym::Expr e) const {
-  if (e->isConstant()) {
-    auto it = constants_.find(constantBits(e->value));
-    return it == constants_.end() ? nullptr : &it->second;
+  if (e->isConstant()) return knownConstant(constantBits(e->value));
+  if (!e->isSymbol()) {
+    const uint32_t* r = memo_.find(e);
+    return r ? r : bodyMemo_.find(e);
   }
-  if (!e->isSymbol()) return memo_.find(e);
   return e->symbolId < symbolRegs_.size() && symbolRegs_[e->symbolId] != kNone ? &symbolRegs_[e->symbolId] : nullptr;
 }
 
 void ProgramBuilder::remember(sym::Expr e, uint32_t reg) {
   if (e->isConstant()) return;  // constant() keeps it
-  if (e->isSymbol()) slot(symbolRegs_, e, kNone) = reg;
-  else memo_.insert(e, reg);
+  if (e->isSymbol()) setSymbolRegister(e, reg);
+  else (inLoop_ ? bodyMemo_ : memo_).insert(e, reg);
+}
+
+void ProgramBuilder::setSymbolRegister(sym::Expr symbol, uint32_t reg) {
+  uint32_t& r = slot(symbolRegs_, symbol, kNone);
+  if (inLoop_) bodySymbols_.emplace_back(symbol->symbolId, r);
+  r = reg;
+}
+
+uint32_t ProgramBuilder::beginLoop(const Loop& loop) {
+  auto id = static_cast<uint32_t>(program_.loops.size());
+  program_.loops.push_back(loop);
+  emit(Op::LoopBegin, 0, 0, 0, id);
+  inLoop_ = true;
+  return id;
+}
+
+void ProgramBuilder::endLoop() {
+  emit(Op::LoopEnd, 0, 0, 0, static_cast<uint32_t>(program_.loops.size() - 1));
+  inLoop_ = false;
+  for (auto it = bodySymbols_.rbegin(); it != bodySymbols_.rend(); ++it) symbolRegs_[it->first] = it->second;
+  bodySymbols_.clear();
+  bodyMemo_.clear();
+  bodyConstants_.clear();
+}
+
+uint32_t ProgramBuilder::appendIndexTable(std::span<const uint32_t> values) {
+  auto base = static_cast<uint32_t>(program_.indexTable.size());
+  program_.indexTable.insert(program_.indexTable.end(), values.begin(), values.end());
+  return base;
 }
 
 // The next child of f.node that needs a register (arguments, non-constant exponents, a

@@ -1,9 +1,11 @@
 // ProgramBuilder: lowers expression DAGs into one kernel Program. Each distinct node becomes at
 // most one instruction (memoised), inputs are loaded on first use, CSE temporaries are lowered on
 // first use, n-ary sums and products become chains of binary operations. Iterative, so any
-// expression depth is fine.
+// expression depth is fine. Loops: between beginLoop and endLoop the instructions form a loop body;
+// what is first lowered there is per-iteration, so the memo forgets it at endLoop.
 #pragma once
 
+#include <span>
 #include <unordered_map>
 
 #include "kernel/Kernel.h"
@@ -19,8 +21,12 @@ class ProgramBuilder {
 
   /// `symbol` reads input `index` with a load opcode (emitted when first used).
   void bindLoad(sym::Expr symbol, Op load, uint32_t index) { slot(loads_, symbol, kNoLoad) = {load, index}; }
-  /// `symbol` is the value already in register `reg`.
-  void bindRegister(sym::Expr symbol, uint32_t reg) { slot(symbolRegs_, symbol, kNone) = reg; }
+  /// `symbol` reads y[index + L] (Op::LoadYLooped) or yp[index + L] (Op::LoadYpLooped) inside loops.
+  void bindLoopedLoad(sym::Expr symbol, Op load, uint32_t index) { bindLoad(symbol, load, index); }
+  /// `symbol` is the loop offset L as a number (ldidx).
+  void bindLoopOffset(sym::Expr symbol) { bindLoad(symbol, Op::LoadLoopOffset, 0); }
+  /// `symbol` is the value already in register `reg` (inside a loop body: until endLoop).
+  void bindRegister(sym::Expr symbol, uint32_t reg) { setSymbolRegister(symbol, reg); }
   /// `symbol` is a CSE temporary standing for `value` (lowered when first used).
   void bindTemporary(sym::Expr symbol, sym::Expr value) { slot(temporaries_, symbol, sym::Expr{nullptr}) = value; }
 
@@ -34,6 +40,17 @@ class ProgramBuilder {
   uint32_t emit(Op op, uint32_t a = 0, uint32_t b = 0, uint32_t c = 0, uint32_t imm = 0);
   /// out[slot] = register reg.
   void store(uint32_t slot, uint32_t reg) { emit(Op::Store, reg, 0, 0, slot); }
+
+  /// Starts a loop body: instructions emitted until endLoop() run loop.count times. Returns the loop id.
+  uint32_t beginLoop(const Loop& loop);
+  /// Ends the body. Nodes, symbols and temporaries first lowered inside the body are forgotten (they
+  /// hold per-iteration values); those lowered before stay valid inside and after.
+  void endLoop();
+  /// out[slot + L] = reg ; out[indexTable[tableBase + c]] = reg   (inside a loop)
+  void storeLooped(uint32_t slot, uint32_t reg) { emit(Op::StoreLooped, reg, 0, 0, slot); }
+  void storeIndexed(uint32_t tableBase, uint32_t reg) { emit(Op::StoreIndexed, reg, 0, 0, tableBase); }
+  /// Appends to the program's indexTable; returns the base index.
+  uint32_t appendIndexTable(std::span<const uint32_t> values);
 
   /// A symbol met that has no binding (lowered as NaN), and the source whose code first used it.
   struct UnboundUse {
@@ -72,7 +89,9 @@ class ProgramBuilder {
   uint32_t power(uint32_t base, double exponent);
   static uint64_t constantBits(double v);
   const uint32_t* known(sym::Expr e) const;
+  const uint32_t* knownConstant(uint64_t bits) const;
   void remember(sym::Expr e, uint32_t reg);
+  void setSymbolRegister(sym::Expr symbol, uint32_t reg);
   uint32_t reg(sym::Expr e) const { return *known(e); }
 
   Program program_;
@@ -82,6 +101,13 @@ class ProgramBuilder {
   std::vector<sym::Expr> temporaries_;                // by symbolId
   std::vector<Load> loads_;                           // by symbolId
   std::unordered_map<uint64_t, uint32_t> constants_;  // bit pattern -> register
+  std::unordered_map<uint64_t, uint32_t> pool_;       // bit pattern -> index in the pool
+  // The open loop body's own values, forgotten at endLoop: nodes, constants, and the symbols'
+  // registers it set (symbol id, register before), undone in reverse.
+  bool inLoop_ = false;
+  sym::NodeMap<uint32_t> bodyMemo_;
+  std::unordered_map<uint64_t, uint32_t> bodyConstants_;
+  std::vector<std::pair<uint32_t, uint32_t>> bodySymbols_;
   std::vector<UnboundUse> unbound_;
   std::vector<Frame> frames_;  // lower()'s stack, kept to reuse its storage
 };

@@ -1,5 +1,9 @@
-// Kernel IR -> LLVM IR. One basic block of straight-line code per function. Semantics follow
-// kernel::interpret (qdot/opcodes.def) bit for bit where LLVM allows it:
+// Kernel IR -> LLVM IR. Straight-line code is one basic block; a loop (qdot/loop.hpp) becomes a
+// body block branching back to itself, with a phi for the iteration c (i64) and the offset L
+// computed from first/stride or loaded from the index table, a private constant global of the
+// module; the body's registers are SSA values of the body block. The inputs' addresses and the
+// values an earlier part computed are loaded in the entry block, so they dominate every loop.
+// Semantics follow kernel::interpret (qdot/opcodes.def) bit for bit where LLVM allows it:
 //  - sqrt, fabs, sin, cos, exp, log, pow are LLVM intrinsics (lowered to the same libm calls or
 //    to correctly rounded instructions); tan, asin, acos, atan, sinh, cosh, tanh, atan2 are libm calls;
 //  - powi is expanded into the multiplications of qdot::bc::powi (same association, so exact);
@@ -25,6 +29,7 @@ namespace qdot::llvmbackend {
 namespace {
 
 using kernel::Instr;
+using kernel::Loop;
 using kernel::Op;
 
 /// The arguments of every generated function, in ProgramFn order.
@@ -58,7 +63,8 @@ llvm::Function* declareProgramFunction(llvm::Module& m, const std::string& name,
   return f;
 }
 
-/// Lowers one part of a program (instructions [begin, end)) into one function: one basic block.
+/// Lowers one part of a program (instructions [begin, end)) into one function: one basic block,
+/// plus a body and an after block per loop.
 /// Registers defined in the part are SSA values; an earlier part's register is either redone (a
 /// load or constant) or reloaded from its spill slot, once per part.
 class PartLowering {
@@ -68,8 +74,13 @@ class PartLowering {
         begin_(begin), end_(end), local_(end - begin, nullptr) {}
 
   void emit() {
-    b_.SetInsertPoint(llvm::BasicBlock::Create(mod_.getContext(), "entry", fn_));
+    entry_ = llvm::BasicBlock::Create(mod_.getContext(), "entry", fn_);
+    b_.SetInsertPoint(entry_);
     for (size_t i = begin_; i < end_; ++i) {
+      if (prog_.code[i].op == Op::LoopBegin && prog_.loops[prog_.code[i].imm].count == 0) {
+        while (prog_.code[i].op != Op::LoopEnd) ++i;  // no iteration: nothing to emit
+        continue;
+      }
       llvm::Value* v = emit(prog_.code[i]);
       local_[i - begin_] = v;
       if (split_.spillSlot[i] != ProgramSplit::kNoSlot) b_.CreateStore(v, elementPtr(kSpill, split_.spillSlot[i], dbl_));
@@ -81,13 +92,22 @@ class PartLowering {
   llvm::Value* elementPtr(Arg a, uint32_t index, llvm::Type* type) {
     return b_.CreateConstInBoundsGEP1_64(type, fn_->getArg(a), index);
   }
+  // Runs `make` with the builder at the end of the entry block (before its branch into a loop):
+  // what it emits dominates the whole function and runs once, not once per iteration.
+  template <class Make>
+  llvm::Value* atEntry(Make make) {
+    llvm::IRBuilderBase::InsertPointGuard guard(b_);
+    if (llvm::Instruction* branch = entry_->getTerminator()) b_.SetInsertPoint(branch);
+    else b_.SetInsertPoint(entry_);
+    return make();
+  }
   // Field `f` of the ModelCall: t and cj are values, the others the arrays' addresses (loaded once
-  // per part; a part is one basic block, so the first load dominates every use).
+  // per part, in the entry block).
   llvm::Value* callField(CallField f) {
     llvm::Value*& v = fields_[f];
     if (!v) {
       llvm::Type* type = f <= kCj ? dbl_ : static_cast<llvm::Type*>(llvm::PointerType::getUnqual(mod_.getContext()));
-      v = b_.CreateLoad(type, b_.CreateStructGEP(callType(mod_.getContext()), fn_->getArg(kCall), f));
+      v = atEntry([&] { return b_.CreateLoad(type, b_.CreateStructGEP(callType(mod_.getContext()), fn_->getArg(kCall), f)); });
     }
     return v;
   }
@@ -102,9 +122,50 @@ class PartLowering {
     auto [it, fresh] = imported_.try_emplace(v, nullptr);
     if (fresh) {
       const Instr& def = prog_.code[v];
-      it->second = rematerialisable(def.op) ? emit(def) : b_.CreateLoad(dbl_, elementPtr(kSpill, split_.spillSlot[v], dbl_));
+      it->second = atEntry([&] {
+        return rematerialisable(def.op) ? emit(def) : b_.CreateLoad(dbl_, elementPtr(kSpill, split_.spillSlot[v], dbl_));
+      });
     }
     return it->second;
+  }
+
+  // `loop`: the body block, entered with c = 0; L for this iteration.
+  void beginLoop(const Instr& ins) {
+    const Loop& loop = prog_.loops[ins.imm];
+    llvm::BasicBlock* before = b_.GetInsertBlock();
+    body_ = llvm::BasicBlock::Create(mod_.getContext(), "loop" + std::to_string(ins.imm), fn_);
+    b_.CreateBr(body_);
+    b_.SetInsertPoint(body_);
+    c_ = b_.CreatePHI(b_.getInt64Ty(), 2, "c");
+    c_->addIncoming(b_.getInt64(0), before);
+    count_ = loop.count;
+    if (loop.offsetTable == Loop::kNoTable) L_ = b_.CreateAdd(b_.getInt64(loop.first), b_.CreateMul(c_, b_.getInt64(loop.stride)));
+    else L_ = tableEntry(loop.offsetTable);
+  }
+  // `endloop`: back to the body while c + 1 < count, else on in a new block.
+  void endLoop(const Instr& ins) {
+    llvm::Value* next = b_.CreateAdd(c_, b_.getInt64(1));
+    c_->addIncoming(next, b_.GetInsertBlock());
+    auto* after = llvm::BasicBlock::Create(mod_.getContext(), "after" + std::to_string(ins.imm), fn_);
+    b_.CreateCondBr(b_.CreateICmpULT(next, b_.getInt64(count_)), body_, after);
+    b_.SetInsertPoint(after);
+  }
+  // X[base + c] as an i64 (the index table: a private constant global of the module, one per program).
+  llvm::Value* tableEntry(uint32_t base) {
+    llvm::Type* i32 = b_.getInt32Ty();
+    auto* type = llvm::ArrayType::get(i32, prog_.indexTable.size());
+    std::string name = "qdot.X." + prog_.name;
+    llvm::GlobalVariable* table = mod_.getNamedGlobal(name);
+    if (!table || table->getValueType() != type) {
+      auto* init = llvm::ConstantDataArray::get(mod_.getContext(), llvm::ArrayRef<uint32_t>(prog_.indexTable));
+      table = new llvm::GlobalVariable(mod_, type, true, llvm::GlobalValue::PrivateLinkage, init, name);
+    }
+    llvm::Value* at = b_.CreateInBoundsGEP(i32, table, b_.CreateAdd(b_.getInt64(base), c_));
+    return b_.CreateZExt(b_.CreateLoad(i32, at), b_.getInt64Ty());
+  }
+  // &array[imm + L] of a looped load or store.
+  llvm::Value* loopedPtr(llvm::Value* array, uint32_t imm) {
+    return b_.CreateInBoundsGEP(dbl_, array, b_.CreateAdd(b_.getInt64(imm), L_));
   }
 
   llvm::Value* boolean(llvm::Value* cond) {
@@ -200,6 +261,17 @@ class PartLowering {
       case Op::Not: return boolean(b_.CreateFCmpOEQ(A(), constant(0.0)));
       case Op::Select: return b_.CreateSelect(isTrue(A()), B(), value(ins.c));
       case Op::Store: b_.CreateStore(A(), elementPtr(kOut, ins.imm, dbl_)); return nullptr;
+      case Op::LoopBegin: beginLoop(ins); return nullptr;
+      case Op::LoopEnd: endLoop(ins); return nullptr;
+      case Op::LoadYLooped: return b_.CreateLoad(dbl_, loopedPtr(callField(kY), ins.imm));
+      case Op::LoadYpLooped: return b_.CreateLoad(dbl_, loopedPtr(callField(kYp), ins.imm));
+      case Op::LoadLoopOffset: return b_.CreateSIToFP(L_, dbl_);
+      case Op::StoreLooped: b_.CreateStore(A(), loopedPtr(fn_->getArg(kOut), ins.imm)); return nullptr;
+      case Op::StoreIndexed: {
+        llvm::Value* slot = tableEntry(ins.imm);
+        b_.CreateStore(A(), b_.CreateInBoundsGEP(dbl_, fn_->getArg(kOut), slot));
+        return nullptr;
+      }
     }
     return nullptr;
   }
@@ -214,6 +286,12 @@ class PartLowering {
   std::vector<llvm::Value*> local_;                       // values of [begin_, end_)
   std::unordered_map<uint32_t, llvm::Value*> imported_;  // earlier parts' values used here
   std::array<llvm::Value*, kOverridden + 1> fields_{};    // ModelCall fields loaded in this part
+  llvm::BasicBlock* entry_ = nullptr;
+  // The open loop: its body block, the iteration phi, its offset in this iteration, its count.
+  llvm::BasicBlock* body_ = nullptr;
+  llvm::PHINode* c_ = nullptr;
+  llvm::Value* L_ = nullptr;
+  uint32_t count_ = 0;
 };
 
 void emitCaller(llvm::Function* entry, const std::vector<llvm::Function*>& parts) {

@@ -1,6 +1,7 @@
 // splitProgram and planCompile: see CompilePlan.h.
 #include "llvm/CompilePlan.h"
 
+#include <algorithm>
 #include <map>
 
 namespace qdot::llvmbackend {
@@ -14,13 +15,43 @@ bool rematerialisable(kernel::Op op) {
   }
 }
 
+namespace {
+
+// The first instruction of each part: every `chunk` instructions, except that a cut inside a loop
+// moves to the loop's `loop` (or past its `endloop` if that would leave the part empty).
+std::vector<uint32_t> partStarts(const kernel::Program& p, uint32_t chunk) {
+  const size_t n = p.code.size();
+  std::vector<uint32_t> loopBegin(n, UINT32_MAX), loopEnd(n, 0);  // per instruction of a loop
+  for (size_t i = 0, b = UINT32_MAX; i < n; ++i) {
+    if (p.code[i].op == kernel::Op::LoopBegin) b = i;
+    if (b != UINT32_MAX) loopBegin[i] = static_cast<uint32_t>(b);
+    if (p.code[i].op == kernel::Op::LoopEnd) {
+      for (size_t j = b; j <= i; ++j) loopEnd[j] = static_cast<uint32_t>(i);
+      b = UINT32_MAX;
+    }
+  }
+  std::vector<uint32_t> starts{0};
+  for (size_t start = 0, cut; (cut = start + chunk) < n; start = cut) {
+    if (loopBegin[cut] != UINT32_MAX && loopBegin[cut] < cut)  // instructions cut-1 and cut share a loop
+      cut = loopBegin[cut] > start ? loopBegin[cut] : loopEnd[cut] + 1;
+    if (cut >= n) break;
+    starts.push_back(static_cast<uint32_t>(cut));
+  }
+  return starts;
+}
+
+}  // namespace
+
 ProgramSplit splitProgram(const kernel::Program& p, uint32_t maxInstructions) {
   ProgramSplit s;
   size_t n = p.code.size();
-  s.chunk = std::max<uint32_t>(1, maxInstructions);
-  s.parts = static_cast<uint32_t>(std::max<size_t>(1, (n + s.chunk - 1) / s.chunk));
+  s.starts = partStarts(p, std::max<uint32_t>(1, maxInstructions));
+  s.parts = static_cast<uint32_t>(s.starts.size());
   s.spillSlot.assign(n, ProgramSplit::kNoSlot);
-  auto partOf = [&](size_t i) { return i / s.chunk; };
+  std::vector<uint32_t> part(n, 0);
+  for (uint32_t k = 0; k < s.parts; ++k)
+    std::fill(part.begin() + s.begin(k), part.begin() + s.end(k, n), k);
+  auto partOf = [&](size_t i) { return part[i]; };
   for (size_t i = 0; i < n; ++i) {
     const kernel::Instr& ins = p.code[i];
     const uint32_t operands[3] = {ins.a, ins.b, ins.c};

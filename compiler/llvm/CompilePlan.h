@@ -14,25 +14,27 @@
 
 namespace qdot::llvmbackend {
 
-/// How a program is cut into parts of at most `chunk` kernel instructions (part k = instructions
-/// [k·chunk, (k+1)·chunk)) and which values cross from one part to a later one through the spill
-/// array. Computed once per program; every part's lowering reads it, so parts can be lowered
+/// How a program is cut into parts of about `maxInstructions` kernel instructions (part k =
+/// instructions [starts[k], starts[k+1])), never inside a loop (a loop stays whole in one function,
+/// however long), and which values cross from one part to a later one through the spill array.
+/// Computed once per program; every part's lowering reads it, so parts can be lowered
 /// independently (in different modules and threads).
 struct ProgramSplit {
-  uint32_t chunk = 1;
   uint32_t parts = 0;
+  std::vector<uint32_t> starts;     ///< per part: its first instruction
   std::vector<uint32_t> spillSlot;  ///< per instruction: its slot, or kNoSlot
   uint32_t spillSlots = 0;          ///< doubles of spill memory the program needs
   static constexpr uint32_t kNoSlot = UINT32_MAX;
 
-  size_t begin(uint32_t part) const { return size_t(part) * chunk; }
-  size_t end(uint32_t part, size_t size) const { return std::min(size, size_t(part + 1) * chunk); }
+  size_t begin(uint32_t part) const { return starts[part]; }
+  size_t end(uint32_t part, size_t size) const { return part + 1 < parts ? starts[part + 1] : size; }
 };
 
 /// Loads and constants: cheaper to redo in a later part than to pass through the spill array.
 bool rematerialisable(kernel::Op op);
 
-/// Splits `p` into parts of at most `maxInstructions` (>= 1) instructions.
+/// Splits `p` into parts of at most `maxInstructions` (>= 1) instructions, except that a loop is
+/// never cut (a part holding one may be longer).
 ProgramSplit splitProgram(const kernel::Program& p, uint32_t maxInstructions);
 
 /// The LLVM function name of a program's entry ("qdot_residual").

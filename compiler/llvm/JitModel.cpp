@@ -24,6 +24,8 @@ ProgramTrace traceOf(const kernel::Program& p) {
   }
   trace.constants = p.constants;
   trace.registerCount = static_cast<uint32_t>(p.code.size());
+  trace.loops = p.loops;
+  trace.indexTable = p.indexTable;
   return trace;
 }
 

@@ -19,6 +19,7 @@ std::string indexName(const bc::Module& m, bc::Opcode op, uint32_t i, const bc::
   if (op == bc::Opcode::LoadP || op == bc::Opcode::LoadGiven || op == bc::Opcode::LoadOverridden)
     names = &m.description.parameterNames;
   if (op == bc::Opcode::LoadConst && i < f.constants.size()) return std::to_string(i) + std::string(" (").append(shortestText(f.constants[i])) + ")";
+  if (op == bc::Opcode::LoadYLooped || op == bc::Opcode::LoadYpLooped) return std::to_string(i) + " + L";
   return std::to_string(i) + (names && i < names->size() ? std::string(" (").append((*names)[i]) + ")" : "");
 }
 
@@ -34,6 +35,13 @@ std::string operandText(const bc::Module& m, const bc::Function& f, const uint32
     case bc::Format::Ternary: return reg(o[0]) + ", " + reg(o[1]) + ", " + reg(o[2]) + ", " + reg(o[3]);
     case bc::Format::UnaryIndex: return reg(o[0]) + ", " + reg(o[1]) + ", " + std::to_string(static_cast<int32_t>(o[2]));
     case bc::Format::Store: return std::string("out[").append(std::to_string(o[0])) + "], " + reg(o[1]);
+    case bc::Format::StoreLooped: return std::string("out[").append(std::to_string(o[0])) + " + L], " + reg(o[1]);
+    case bc::Format::StoreIndexed: return std::string("out[X[").append(std::to_string(o[0])) + " + c]], " + reg(o[1]);
+    case bc::Format::LoopBegin: {
+      std::string exit = "exit " + std::to_string(ip - f.code.data() + o[1]);
+      return std::to_string(o[0]) + " (" + (o[0] < f.loops.size() ? loopText(f.loops[o[0]]) + ", " : "") + exit + ")";
+    }
+    case bc::Format::LoopEnd: return std::to_string(o[0]);
   }
   return "";
 }
@@ -54,8 +62,12 @@ void disassembleFunction(std::ostream& os, const bc::Module& m, ModelProgram pro
      << f.constants.size() << " constants), " << f.outputCount << " outputs, " << instructions << " instructions, "
      << f.code.size() << " words\n";
   for (size_t k = 0; k < f.constants.size(); ++k) os << "  " << reg(k) << " = " << shortestText(f.constants[k]) << "\n";
+  if (!f.indexTable.empty()) os << "  X =";
+  for (uint32_t x : f.indexTable) os << " " << x;
+  if (!f.indexTable.empty()) os << "\n";
   uint32_t source = bc::kNoSource - 1;
   size_t ordinal = 0;
+  bool inLoop = false;  // indents loop bodies
   for (size_t pc = 0; pc < f.code.size() && f.code[pc] < bc::kOpcodeCount; ++ordinal) {
     const uint32_t* ip = &f.code[pc];
     uint32_t loc = ordinal < f.sources.size() ? f.sources[ordinal] : bc::kNoSource;
@@ -66,7 +78,9 @@ void disassembleFunction(std::ostream& os, const bc::Module& m, ModelProgram pro
     std::snprintf(offset, sizeof offset, "%04zu", pc);
     std::string ops = operandText(m, f, ip), name = info.mnemonic;
     if (!ops.empty()) name.resize(std::max<size_t>(name.size() + 1, 8), ' ');
-    os << "  " << offset << "  " << name << ops << "\n";
+    if (info.format == bc::Format::LoopEnd) inLoop = false;
+    os << "  " << offset << (inLoop ? "    " : "  ") << name << ops << "\n";
+    if (info.format == bc::Format::LoopBegin) inLoop = true;
     pc += 1 + bc::operandCount(info.format);
   }
 }

@@ -2,6 +2,8 @@
 // format, computes the opcode's value expression and jumps to the next handler (computed goto),
 // or, with QDOT_VM_NO_COMPUTED_GOTO or a compiler without labels-as-values, loops over a switch.
 // Included by Interpreter.cpp (both variants) — every handler reads its operands before writing.
+// Loop state lives in locals: the open loop, its iteration c, its offset L and the body's first
+// word (loops do not nest, so one of each).
 #pragma once
 
 #include <cmath>
@@ -18,18 +20,27 @@
 #define QDOT_VM_Ternary(E) { const double A = r[ip[2]], B = r[ip[3]], C = r[ip[4]]; r[ip[1]] = (E); ip += 5; }
 #define QDOT_VM_UnaryIndex(E) { const double A = r[ip[2]]; const uint32_t I = ip[3]; r[ip[1]] = (E); ip += 4; }
 #define QDOT_VM_Store(E) { const double A = r[ip[2]]; out[ip[1]] = (E); ip += 3; }
+#define QDOT_VM_StoreLooped(E) { const double A = r[ip[2]]; out[ip[1] + L] = (E); ip += 3; }
+#define QDOT_VM_StoreIndexed(E) { const double A = r[ip[2]]; out[X[ip[1] + c]] = (E); ip += 3; }
+#define QDOT_VM_LoopBegin(E) \
+  { loop = &loops[ip[1]], c = 0; if (loop->count == 0) ip += ip[2]; else L = loop->offset(0, X), ip += 3, body = ip; }
+#define QDOT_VM_LoopEnd(E) { if (++c < loop->count) L = loop->offset(c, X), ip = body; else ip += 2; }
 
-// The inputs as the names the value expressions of opcodes.def use.
+// The inputs and the loop state as the names the value expressions of opcodes.def use.
 #define QDOT_VM_INPUTS                                                         \
   [[maybe_unused]] const double t = in.t, cj = in.cj;                          \
   [[maybe_unused]] const double *y = in.y, *yp = in.yp, *p = in.p, *given = in.given; \
-  [[maybe_unused]] const uint8_t* overridden = in.overridden;
+  [[maybe_unused]] const uint8_t* overridden = in.overridden;                \
+  [[maybe_unused]] const Loop* loop = nullptr;                                 \
+  [[maybe_unused]] const uint32_t* body = nullptr;                             \
+  [[maybe_unused]] uint32_t c = 0;                                             \
+  [[maybe_unused]] int64_t L = 0;
 
 namespace qdot::vm::detail {
 
 #if defined(__GNUC__) || defined(__clang__)
 inline void loopComputedGoto(const uint32_t* ip, double* __restrict r, const ModelCall& in, const double* k,
-                             double* __restrict out) {
+                             double* __restrict out, const Loop* loops, const uint32_t* X) {
   QDOT_VM_INPUTS
   static const void* const handlers[] = {
 #define QDOT_OPCODE(Name, Mnemonic, Format, Value) &&op_##Name,
@@ -42,7 +53,8 @@ inline void loopComputedGoto(const uint32_t* ip, double* __restrict r, const Mod
 }
 #endif
 
-inline void loopSwitch(const uint32_t* ip, double* r, const ModelCall& in, const double* k, double* out) {
+inline void loopSwitch(const uint32_t* ip, double* r, const ModelCall& in, const double* k, double* out,
+                       const Loop* loops, const uint32_t* X) {
   QDOT_VM_INPUTS
   for (;;) {
     switch (static_cast<bc::Opcode>(*ip)) {

@@ -10,14 +10,14 @@ namespace qdot::vm {
 
 void execute(const bc::Function& f, double* registers, const ModelCall& in, double* out) {
 #if (defined(__GNUC__) || defined(__clang__)) && !defined(QDOT_VM_NO_COMPUTED_GOTO)
-  detail::loopComputedGoto(f.code.data(), registers, in, f.constants.data(), out);
+  detail::loopComputedGoto(f.code.data(), registers, in, f.constants.data(), out, f.loops.data(), f.indexTable.data());
 #else
-  detail::loopSwitch(f.code.data(), registers, in, f.constants.data(), out);
+  detail::loopSwitch(f.code.data(), registers, in, f.constants.data(), out, f.loops.data(), f.indexTable.data());
 #endif
 }
 
 void executeWithSwitch(const bc::Function& f, double* registers, const ModelCall& in, double* out) {
-  detail::loopSwitch(f.code.data(), registers, in, f.constants.data(), out);
+  detail::loopSwitch(f.code.data(), registers, in, f.constants.data(), out, f.loops.data(), f.indexTable.data());
 }
 
 std::vector<double> makeRegisters(const bc::Function& f) {
@@ -35,6 +35,8 @@ ProgramTrace traceOf(const bc::Function& f) {
   trace.constants = f.constants;
   trace.preloaded = static_cast<uint32_t>(f.constants.size());
   trace.registerCount = f.registerCount;
+  trace.loops = f.loops;
+  trace.indexTable = f.indexTable;
   return trace;
 }
 

@@ -94,6 +94,9 @@ void writeFunction(Writer& w, const Function& f) {
   for (double c : f.constants) w.f64(c);
   w.words(f.code);
   w.words(f.sources);
+  w.u32(static_cast<uint32_t>(f.loops.size()));
+  for (const Loop& l : f.loops) w.u32(l.count), w.u32(static_cast<uint32_t>(l.first)), w.u32(static_cast<uint32_t>(l.stride)), w.u32(l.offsetTable);
+  w.words(f.indexTable);
 }
 
 Function readFunction(Reader& r) {
@@ -104,6 +107,10 @@ Function readFunction(Reader& r) {
   for (double& c : f.constants) c = r.f64();
   f.code = r.words<uint32_t>();
   f.sources = r.words<uint32_t>();
+  f.loops.resize(r.count(16));
+  for (Loop& l : f.loops)
+    l.count = r.u32(), l.first = static_cast<int32_t>(r.u32()), l.stride = static_cast<int32_t>(r.u32()), l.offsetTable = r.u32();
+  f.indexTable = r.words<uint32_t>();
   return f;
 }
 

@@ -13,6 +13,7 @@
 #include <string_view>
 #include <vector>
 
+#include "qdot/loop.hpp"
 #include "qdot/model_description.hpp"
 #include "qdot/programs.hpp"
 #include "qdot/result.hpp"
@@ -35,7 +36,11 @@ enum class Opcode : uint8_t {
   X(Binary, 3, 2)                   \
   X(Ternary, 4, 3)                  \
   X(UnaryIndex, 3, 1)               \
-  X(Store, 2, 1)
+  X(Store, 2, 1)                    \
+  X(StoreLooped, 2, 1)              \
+  X(StoreIndexed, 2, 1)             \
+  X(LoopBegin, 2, 0)                \
+  X(LoopEnd, 1, 0)
 
 /// Operand layout of an instruction (see the table at the top of qdot/opcodes.def).
 enum class Format : uint8_t {
@@ -64,12 +69,14 @@ inline constexpr uint32_t readCount(Format f) {
   return reads[static_cast<uint8_t>(f)];
 }
 
-/// True if an instruction of format f writes a register (all but End and Store).
-inline constexpr bool definesRegister(Format f) { return f != Format::End && f != Format::Store; }
-/// True if the last operand word is an immediate (an input/pool index, an exponent, an output slot).
-inline constexpr bool hasImmediate(Format f) {
-  return f == Format::Index || f == Format::UnaryIndex || f == Format::Store;
+/// True for the formats writing out[] (st, stl, stx).
+inline constexpr bool isStore(Format f) {
+  return f == Format::Store || f == Format::StoreLooped || f == Format::StoreIndexed;
 }
+/// True for `loop` and `endloop`.
+inline constexpr bool isLoopControl(Format f) { return f == Format::LoopBegin || f == Format::LoopEnd; }
+/// True if an instruction of format f writes a register (all but End, the stores and loop control).
+inline constexpr bool definesRegister(Format f) { return f != Format::End && !isStore(f) && !isLoopControl(f); }
 
 /// What the disassembler and the validator need to know about an opcode.
 struct OpcodeInfo {
@@ -88,20 +95,22 @@ inline constexpr uint32_t kOpcodeCount = sizeof(kOpcodes) / sizeof(kOpcodes[0]);
 inline const OpcodeInfo& info(Opcode op) { return kOpcodes[static_cast<uint8_t>(op)]; }
 
 /// An instruction with its operands named as in the kernel IR: `dest` the register it defines,
-/// a, b, c the registers it reads, `imm` its immediate (for `st`: the output slot).
+/// a, b, c the registers it reads, `imm` its immediate (for stores: the output slot or table
+/// index; for `loop`, `endloop`: the loop id).
 struct Instruction {
   Opcode op = Opcode::Ret;
   uint32_t dest = 0, a = 0, b = 0, c = 0, imm = 0;
 };
 
-/// The instruction whose opcode word is ip[0] (layout: dest, registers read, immediate; `st`: slot, a).
+/// The instruction whose opcode word is ip[0] (layout: dest, registers read, immediate; stores:
+/// slot, a; `loop`: id, exit distance; `endloop`: id).
 inline Instruction decode(const uint32_t* ip) {
   Instruction ins;
   ins.op = static_cast<Opcode>(ip[0]);
   Format f = info(ins.op).format;
   const uint32_t* o = ip + 1;
   if (definesRegister(f)) ins.dest = *o++;
-  if (f == Format::Store) ins.imm = *o++;
+  if (isStore(f) || isLoopControl(f)) ins.imm = *o++;
   uint32_t* reads[3] = {&ins.a, &ins.b, &ins.c};
   for (uint32_t i = 0; i < readCount(f); ++i) *reads[i] = *o++;
   if (f == Format::Index || f == Format::UnaryIndex) ins.imm = *o;
@@ -136,15 +145,18 @@ inline double sign(double x) { return x > 0.0 ? 1.0 : (x < 0.0 ? -1.0 : (x == 0.
 /// Function::sources entry of an instruction that serves no particular source.
 inline constexpr uint32_t kNoSource = UINT32_MAX;
 
-/// One straight-line register program. Registers [0, constants.size()) hold the constant pool
-/// (loaded once, never written); the rest are scratch. Code is a sequence of instructions, each an
-/// opcode word (value < 256) followed by operandCount(format) operand words; the last is `ret`.
+/// One register program: straight-line code with loops (qdot/loop.hpp). Registers
+/// [0, constants.size()) hold the constant pool (loaded once, never written); the rest are scratch.
+/// Code is a sequence of instructions, each an opcode word (value < 256) followed by
+/// operandCount(format) operand words; the last is `ret`.
 struct Function {
   uint32_t registerCount = 0;
   uint32_t outputCount = 0;       ///< number of out[] slots the stores write
   std::vector<double> constants;  ///< the pool (also addressable with `ldk`)
   std::vector<uint32_t> code;
   std::vector<uint32_t> sources;  ///< per instruction (in order): index into Module::locations, or kNoSource
+  std::vector<Loop> loops;        ///< by loop id (the immediate of `loop`, `endloop`)
+  std::vector<uint32_t> indexTable;  ///< X: loop offsets of table loops, output slots of `stx`
 };
 
 /// Where an instruction comes from, for error messages: "<label> at <where>".
@@ -155,7 +167,7 @@ struct Location {
 };
 
 /// Version of the serialised form; deserialize refuses any other.
-inline constexpr uint32_t kFormatVersion = 5;
+inline constexpr uint32_t kFormatVersion = 6;
 
 /// A whole model: its description (names, flags, Jacobian pattern) and one function per program.
 struct Module {

@@ -5,7 +5,8 @@
 // NaN in an untaken branch is never blamed; a non-finite constant (e.g. a parameter without a
 // value) makes a value "undefined". The one diagnosis of both backends: the VM decodes its
 // bytecode into a ProgramTrace, the LLVM backend its kernel IR. Header-only so that neither
-// backend links the other (it runs only after a failure; speed does not matter).
+// backend links the other (it runs only after a failure; speed does not matter). Loops run as the
+// VM runs them; a value going wrong inside one is named with its iteration and loop offset.
 #pragma once
 
 #include <cmath>
@@ -21,13 +22,15 @@
 
 namespace qdot {
 
-/// A straight-line program as the diagnosis reads it.
+/// A program as the diagnosis reads it.
 struct ProgramTrace {
   std::vector<bc::Instruction> code;  ///< in order; a `ret` ends it
   std::vector<uint32_t> sources;      ///< per instruction: index into the locations, or bc::kNoSource
   std::span<const double> constants;  ///< the pool `ldk` reads
   uint32_t preloaded = 0;             ///< registers [0, preloaded) start as constants[0, preloaded)
   uint32_t registerCount = 0;
+  std::span<const Loop> loops;           ///< by loop id
+  std::span<const uint32_t> indexTable;  ///< X
 };
 
 namespace detail {
@@ -35,8 +38,37 @@ namespace detail {
 inline constexpr uint32_t kFiniteOrigin = UINT32_MAX;        // origin of a finite value
 inline constexpr uint32_t kConstantOrigin = UINT32_MAX - 1;  // a non-finite constant of the pool
 
+// Where the re-run is: the open loop (nullptr outside loops), its iteration c and offset L, and
+// the ordinal of its body's first instruction.
+struct LoopPosition {
+  const Loop* loop = nullptr;
+  uint32_t c = 0;
+  int64_t L = 0;
+  uint32_t body = 0;
+};
+
+// The ordinal of the instruction to run after loop control instruction `i` (`loop`, `endloop`).
+inline uint32_t stepLoop(const ProgramTrace& trace, uint32_t i, LoopPosition& at) {
+  if (trace.code[i].op == bc::Opcode::LoopBegin) {
+    at = {&trace.loops[trace.code[i].imm], 0, 0, i + 1};
+  } else if (++at.c == at.loop->count) {
+    at.loop = nullptr;
+    return i + 1;
+  }
+  if (at.loop->count == 0) {  // no iteration: past its endloop
+    while (trace.code[i].op != bc::Opcode::LoopEnd) ++i;
+    at.loop = nullptr;
+    return i + 1;
+  }
+  at.L = at.loop->offset(at.c, trace.indexTable.data());
+  return at.body;
+}
+
 // The value `ins` computes (a store: the value stored).
-inline double evaluate(const bc::Instruction& ins, const std::vector<double>& r, const ModelCall& in, const double* k) {
+inline double evaluate(const bc::Instruction& ins, const std::vector<double>& r, const ModelCall& in, const double* k,
+                       const LoopPosition& at) {
+  [[maybe_unused]] const uint32_t c = at.c;
+  [[maybe_unused]] const int64_t L = at.L;
   [[maybe_unused]] const double t = in.t, cj = in.cj;
   [[maybe_unused]] const double *y = in.y, *yp = in.yp, *p = in.p, *given = in.given;
   [[maybe_unused]] const uint8_t* overridden = in.overridden;
@@ -62,8 +94,9 @@ inline std::string nameAt(const std::vector<std::string>& names, uint32_t i) { r
 
 // Why `ins` produced a non-finite value from finite operands A, B (or from nothing, for loads).
 inline std::string describeProblem(const ModelDescription& d, const bc::Instruction& ins, double A, double B,
-                                   double value) {
+                                   double value, int64_t L) {
   const std::string a = shortestText(A), b = shortestText(B), v = shortestText(value);
+  const auto looped = static_cast<uint32_t>(ins.imm + L);
   switch (ins.op) {
     case bc::Opcode::Sqrt: return "sqrt of a negative number (" + a + ")";
     case bc::Opcode::Log: return A == 0.0 ? "log of zero" : "log of a negative number (" + a + ")";
@@ -79,6 +112,8 @@ inline std::string describeProblem(const ModelDescription& d, const bc::Instruct
     }
     case bc::Opcode::LoadY: return "the value of " + nameAt(d.variableNames, ins.imm) + " is " + v;
     case bc::Opcode::LoadYp: return "the value of der(" + nameAt(d.variableNames, ins.imm) + ") is " + v;
+    case bc::Opcode::LoadYLooped: return "the value of " + nameAt(d.variableNames, looped) + " is " + v;
+    case bc::Opcode::LoadYpLooped: return "the value of der(" + nameAt(d.variableNames, looped) + ") is " + v;
     case bc::Opcode::LoadP: return "parameter " + nameAt(d.parameterNames, ins.imm) + " is " + v;
     case bc::Opcode::LoadGiven: return "the value given for parameter " + nameAt(d.parameterNames, ins.imm) + " is " + v;
     case bc::Opcode::LoadTime: return "time is " + v;
@@ -120,9 +155,15 @@ inline std::string diagnoseNonFinite(const ModelDescription& d, std::span<const 
   for (uint32_t i = 0; i < trace.preloaded; ++i)
     if (!std::isfinite(r[i] = trace.constants[i])) origin[i] = kConstantOrigin;
   std::unordered_map<uint32_t, std::string> problems;  // culprit ordinal -> what went wrong
-  for (uint32_t i = 0; i < trace.code.size(); ++i) {
+  LoopPosition at;
+  for (uint32_t i = 0, next = 0; i < trace.code.size(); i = next) {
     const bc::Instruction& ins = trace.code[i];
+    next = i + 1;
     if (ins.op == bc::Opcode::Ret) break;
+    if (ins.op == bc::Opcode::LoopBegin || ins.op == bc::Opcode::LoopEnd) {
+      next = stepLoop(trace, i, at);
+      continue;
+    }
     uint32_t deps[3], from = kFiniteOrigin;
     bool undefined = false;  // depends on a non-finite constant
     for (uint32_t j = 0, n = dependencies(ins, r, deps); j < n; ++j) {
@@ -130,7 +171,7 @@ inline std::string diagnoseNonFinite(const ModelDescription& d, std::span<const 
       if (origin[deps[j]] == kConstantOrigin) undefined = true;
       else if (from == kFiniteOrigin) from = origin[deps[j]];
     }
-    double value = evaluate(ins, r, in, trace.constants.data());
+    double value = evaluate(ins, r, in, trace.constants.data(), at);
     if (ins.op == bc::Opcode::LoadConst) {
       r[ins.dest] = value, origin[ins.dest] = std::isfinite(value) ? kFiniteOrigin : kConstantOrigin;
       continue;
@@ -138,9 +179,11 @@ inline std::string diagnoseNonFinite(const ModelDescription& d, std::span<const 
     if (!std::isfinite(value) && from == kFiniteOrigin) {
       from = i;
       problems[i] = undefined ? "undefined value (" + shortestText(value) + ")"
-                              : describeProblem(d, ins, r[ins.a], r[ins.b], value);
+                              : describeProblem(d, ins, r[ins.a], r[ins.b], value, at.L);
+      if (at.loop)
+        problems[i] += " (loop iteration " + std::to_string(at.c) + ", offset " + std::to_string(at.L) + ")";
     }
-    if (ins.op == bc::Opcode::Store) {
+    if (bc::isStore(bc::info(ins.op).format)) {
       if (!std::isfinite(value)) return problems[from] + placeOf(trace, locations, from, i, program);
       continue;
     }

@@ -35,6 +35,33 @@ TEST(CompilePlan, SplitSpillsComputedValuesAndRecomputesLoads) {
   EXPECT_EQ(s.end(2, 7), 7u);
 }
 
+TEST(CompilePlan, SplitsNeverCutALoop) {
+  // ldy; loop (ldyl, mul x6, stl) endloop; then a chain; parts of 3 would cut the loop anywhere.
+  kernel::Program p;
+  p.loops = {kernel::Loop{.count = 4}};
+  p.code.push_back(Instr{Op::LoadY, 0, 0, 0, 0});
+  p.code.push_back(Instr{Op::LoopBegin, 0, 0, 0, 0});
+  p.code.push_back(Instr{Op::LoadYLooped, 0, 0, 0, 0});
+  for (uint32_t i = 3; i < 9; ++i) p.code.push_back(Instr{Op::Mul, i - 1, 0, 0, 0});
+  p.code.push_back(Instr{Op::StoreLooped, 8, 0, 0, 0});
+  p.code.push_back(Instr{Op::LoopEnd, 0, 0, 0, 0});
+  for (uint32_t i = 0; i < 5; ++i) p.code.push_back(Instr{Op::Mul, 0, 0, 0, 0});
+  p.outputCount = 4;
+  for (uint32_t chunk : {1u, 2u, 3u, 5u, 11u}) {
+    llvmbackend::ProgramSplit s = llvmbackend::splitProgram(p, chunk);
+    size_t covered = 0;
+    for (uint32_t k = 0; k < s.parts; ++k) {
+      size_t b = s.begin(k), e = s.end(k, p.code.size());
+      EXPECT_EQ(b, covered) << chunk;
+      EXPECT_LT(b, e) << chunk;
+      EXPECT_FALSE(b > 1 && b <= 10) << "part " << k << " starts inside the loop, chunk " << chunk;
+      EXPECT_TRUE(e - b <= chunk || (b <= 1 && e >= 11)) << "only a part holding the loop may be longer";
+      covered = e;
+    }
+    EXPECT_EQ(covered, p.code.size());
+  }
+}
+
 TEST(CompilePlan, UnitsCoverEveryPartOnceAtTheProgramsLevel) {
   kernel::KernelModule k;
   for (size_t i = 0; i < kModelProgramCount; ++i) k.programs[i] = chain(50 + 40 * static_cast<uint32_t>(i));

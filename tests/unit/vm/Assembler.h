@@ -24,6 +24,12 @@ class Assembler {
     f_.sources.push_back(source);
     return *this;
   }
+  /// Appends one instruction to f (for edits of a finished function).
+  static void append(bc::Function& f, bc::Opcode op, std::initializer_list<uint32_t> operands) {
+    f.code.push_back(static_cast<uint32_t>(op));
+    f.code.insert(f.code.end(), operands);
+    f.sources.push_back(bc::kNoSource);
+  }
   void ret(uint32_t outputs) {
     op(bc::Opcode::Ret, {});
     f_.outputCount = outputs;

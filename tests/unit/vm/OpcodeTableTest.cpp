@@ -31,8 +31,9 @@ TEST(OpcodeTable, MnemonicsAreUniqueAndMapBack) {
   EXPECT_FALSE(bc::opcodeFromMnemonic("frobnicate", unused));
 }
 
-// A residual-like function using every opcode once: registers 0..2 are constants, the loads fill
-// the next ones, and every computing opcode stores its result in out[k].
+// A residual-like function using every opcode once, inside a loop of one iteration (offset 0) so
+// that the looped opcodes are allowed: registers 0..2 are constants, the loads fill the next ones,
+// and every computing opcode stores its result in out[k]; stl and stx store the last one again.
 struct EveryOpcode {
   bc::Module module = tinyModule();
   uint32_t outputs = 0;
@@ -40,13 +41,19 @@ struct EveryOpcode {
   EveryOpcode() {
     bc::Function& f = module.function(ModelProgram::Jacobian);
     Assembler a(f, {0.75, -1.5, 2.0}, bc::kOpcodeCount);
+    f.loops = {Loop{.count = 1, .first = 0, .stride = 1}};
+    a.op(Opcode::LoopBegin, {0, 0});
     uint32_t next = a.r(0);
     for (uint32_t i = 0; i < bc::kOpcodeCount; ++i) {
       auto op = static_cast<Opcode>(i);
       uint32_t d = next++;
       switch (bc::info(op).format) {
         case bc::Format::End:
-        case bc::Format::Store: continue;
+        case bc::Format::Store:
+        case bc::Format::StoreLooped:
+        case bc::Format::StoreIndexed:
+        case bc::Format::LoopBegin:
+        case bc::Format::LoopEnd: continue;
         case bc::Format::None: a.op(op, {d}); break;
         case bc::Format::Index: a.op(op, {d, 0}); break;
         case bc::Format::Unary: a.op(op, {d, 0}); break;
@@ -56,6 +63,11 @@ struct EveryOpcode {
       }
       a.op(Opcode::Store, {outputs++, d});
     }
+    f.indexTable = {outputs + 1};
+    a.op(Opcode::StoreLooped, {outputs, next - 1}).op(Opcode::StoreIndexed, {0, next - 1});
+    a.op(Opcode::LoopEnd, {0});
+    f.code[2] = static_cast<uint32_t>(f.code.size());  // the loop's exit: after its endloop
+    outputs += 2;
     a.ret(outputs);
   }
 };
@@ -65,14 +77,12 @@ TEST(OpcodeTable, DisassemblerPrintsEveryOpcode) {
   std::ostringstream os;
   vm::disassembleFunction(os, m.module, ModelProgram::Jacobian);
   std::string text = os.str();
-  size_t at = 0;
   for (uint32_t i = 0; i < bc::kOpcodeCount; ++i) {
     std::string name = std::string("  ") + bc::kOpcodes[i].mnemonic;
-    size_t found = text.find(name, i == 0 ? 0 : at);
-    if (static_cast<Opcode>(i) == Opcode::Ret) found = text.rfind(name);  // ret comes last
-    EXPECT_NE(found, std::string::npos) << bc::kOpcodes[i].mnemonic << " missing";
-    if (static_cast<Opcode>(i) != Opcode::Ret && found != std::string::npos) at = found;
+    bool found = text.find(name + " ") != std::string::npos || text.find(name + "\n") != std::string::npos;
+    EXPECT_TRUE(found) << bc::kOpcodes[i].mnemonic << " missing";
   }
+  EXPECT_EQ(text.rfind("  ret\n"), text.size() - 6);  // ret comes last
   EXPECT_NE(text.find("powi    r"), std::string::npos);
   EXPECT_NE(text.find(", -3"), std::string::npos);
 }

@@ -1,0 +1,107 @@
+// ProgramBuilder with loops: a stencil template lowered once into a loop body computes what the
+// direct C++ loop computes (kernel::interpret); what was lowered before the loop is reused inside
+// and after it, what was first lowered inside is forgotten at endLoop (lowered again after it,
+// constants sharing their pool entry); ldidx and stx through the index table.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <bit>
+
+#include "kernel/Lowering.h"
+
+namespace qdot::test {
+namespace {
+
+using kernel::Op;
+using sym::Expr;
+
+class LoopLowering : public ::testing::Test {
+ protected:
+  sym::Context ctx;
+  Expr next = ctx.symbol("u[i+1]"), here = ctx.symbol("u[i]"), prev = ctx.symbol("u[i-1]"), k = ctx.symbol("k"),
+       i = ctx.symbol("i");
+  Expr c(double v) { return ctx.constant(v); }
+
+  static size_t count(const kernel::Program& p, Op op) {
+    size_t n = 0;
+    for (const auto& ins : p.code) n += ins.op == op;
+    return n;
+  }
+};
+
+// F[j] = k*k*(u[j+1] - 2u[j] + u[j-1]) + 3 for j = 1 .. n-2, then F[0] = k*k + 3 after the loop.
+TEST_F(LoopLowering, StencilTemplateInALoopBody) {
+  const uint32_t n = 9;
+  kernel::ProgramBuilder b("residual");
+  b.bindLoad(k, Op::LoadP, 0);
+  b.bindLoopedLoad(next, Op::LoadYLooped, 2), b.bindLoopedLoad(here, Op::LoadYLooped, 1);
+  b.bindLoopedLoad(prev, Op::LoadYLooped, 0);
+  uint32_t kReg = b.lower(k);  // hoisted: loaded once, before the loop
+  Expr kk = ctx.mul(k, k);
+  uint32_t id = b.beginLoop(kernel::Loop{.count = n - 2, .first = 0, .stride = 1});
+  EXPECT_EQ(id, 0u);
+  Expr stencil = ctx.add(ctx.mul(kk, ctx.add(std::array<Expr, 3>{next, ctx.mul(c(-2), here), prev})), c(3));
+  b.storeLooped(1, b.lower(stencil));
+  b.endLoop();
+  uint32_t after = b.lower(ctx.add(kk, c(3)));
+  b.store(0, after);
+  b.store(n - 1, b.lower(k));
+  kernel::Program p = b.finish(n);
+
+  EXPECT_EQ(b.lower(k), kReg);
+  EXPECT_EQ(count(p, Op::LoadP), 1u);  // k: once, before the loop, used inside and after
+  EXPECT_EQ(count(p, Op::Mul), 4u);  // k*k, -2*u[i], (k*k)*(...) in the body, k*k again after it
+  EXPECT_EQ(count(p, Op::LoadConst), 3u);  // -2 and 3 in the body, 3 again after it
+  EXPECT_EQ(p.constants.size(), 2u);       // ... sharing the pool entry
+  ASSERT_EQ(p.loops.size(), 1u);
+  EXPECT_EQ(p.code[kReg + 1].op, Op::LoopBegin);
+
+  std::vector<double> y = {0.3, -1.2, 2.5, 0.7, -0.1, 1.9, -2.2, 0.4, 1.1}, F(n, -7.0);
+  double kv = 1.7;
+  kernel::interpret(p, {.y = y.data(), .p = &kv}, F);
+  for (uint32_t j = 1; j + 1 < n; ++j) {
+    double s = kv * kv * (y[j + 1] + -2.0 * y[j] + y[j - 1]) + 3.0;
+    EXPECT_EQ(std::bit_cast<uint64_t>(F[j]), std::bit_cast<uint64_t>(s)) << j;
+  }
+  EXPECT_EQ(F[0], kv * kv + 3.0);
+  EXPECT_EQ(F[n - 1], kv);
+}
+
+// Start values 0.01*i over a table loop, stored through a permutation (stx).
+TEST_F(LoopLowering, LoopOffsetAndIndexedStores) {
+  kernel::ProgramBuilder b("initialValues");
+  std::vector<uint32_t> offsets = {4, 0, 3}, slots = {2, 0, 1};
+  uint32_t offsetBase = b.appendIndexTable(offsets), slotBase = b.appendIndexTable(slots);
+  EXPECT_EQ(offsetBase, 0u);
+  EXPECT_EQ(slotBase, 3u);
+  b.bindLoopOffset(i);
+  b.beginLoop(kernel::Loop{.count = 3, .offsetTable = offsetBase});
+  b.storeIndexed(slotBase, b.lower(ctx.mul(c(0.01), i)));
+  b.endLoop();
+  kernel::Program p = b.finish(3);
+  EXPECT_EQ(count(p, Op::LoadLoopOffset), 1u);
+  std::vector<double> out(3, -1.0);
+  kernel::interpret(p, {}, out);
+  EXPECT_EQ(out[2], 0.01 * 4);
+  EXPECT_EQ(out[0], 0.01 * 0);
+  EXPECT_EQ(out[1], 0.01 * 3);
+}
+
+// A loop of count 0 runs nothing; a loop of count 1 runs its body once.
+TEST_F(LoopLowering, CountZeroAndOne) {
+  for (uint32_t iterations : {0u, 1u}) {
+    kernel::ProgramBuilder b("residual");
+    b.bindLoopedLoad(here, Op::LoadYLooped, 0);
+    b.beginLoop(kernel::Loop{.count = iterations, .first = 2, .stride = 5});
+    b.storeLooped(0, b.lower(ctx.mul(c(2), here)));
+    b.endLoop();
+    kernel::Program p = b.finish(4);
+    std::vector<double> y = {1, 2, 3, 4}, out(4, -1.0);
+    kernel::interpret(p, {.y = y.data()}, out);
+    EXPECT_EQ(out[2], iterations ? 6.0 : -1.0);
+    EXPECT_EQ(out[0] + out[1] + out[3], -3.0);
+  }
+}
+
+}  // namespace
+}  // namespace qdot::test
