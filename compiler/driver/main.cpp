@@ -148,7 +148,8 @@ driver::Backend backendOf(const Options& o) {
 // qdot run: compile (only what --outputs needs), simulate, write the CSV.
 ExitCode run(driver::Compilation& c, Options& o) {
   c.options.results = o.run.outputs;
-  if (!o.run.outputs.empty() && o.run.invariants) c.options.keepInvariants = true;
+  c.options.keepInvariants = o.run.invariants;
+  c.options.keepLoops = true;
   if (std::optional<ExitCode> failed = compileToKernels(c, o)) return *failed;
   driver::RunnableModel m = driver::makeRunnableModel(c, backendOf(o), o.run.invariants);
   if (!m.model) {
