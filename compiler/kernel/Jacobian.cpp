@@ -77,12 +77,26 @@ size_t linear(const std::vector<int>& shape, std::span<const long> subscripts) {
   return k;
 }
 
+// The unknown of an array's first element; element k must be the unknown after it by k (the loops
+// address them so).
+std::pair<int, bool> consecutiveUnknowns(const flat::ArrayVariable& a,
+                                         const std::unordered_map<sym::Expr, std::pair<int, bool>>& unknownOf) {
+  auto it = unknownOf.find(a.elements[0]);
+  if (it == unknownOf.end()) QDOT_UNREACHABLE("a template reads an array that is not of unknowns");
+  for (size_t k = 0; k < a.elements.size(); ++k) {
+    auto e = unknownOf.find(a.elements[k]);
+    if (e == unknownOf.end() || e->second.first != it->second.first + static_cast<int>(k) || e->second.second != it->second.second)
+      QDOT_UNREACHABLE("a template reads an array whose elements are not consecutive unknowns");
+  }
+  return it->second;
+}
+
 // The entries of block b: ∂F/∂y + cj ∂F/∂y' per column pattern, then one Entry per point.
-void templateEntries(const dae::Dae& dae, sym::Context& ctx, sym::Expr cj, size_t b, std::vector<TemplateEntry>& out,
-                     std::vector<Entry>& entries) {
+void templateEntries(const dae::Dae& dae, sym::Context& ctx, sym::Expr cj, size_t b, std::span<const TemplateOperand> operands,
+                     std::vector<TemplateEntry>& out, std::vector<Entry>& entries) {
   const dae::TemplateBlock& block = dae.templateBlocks[b];
   size_t first = out.size();
-  for (const TemplateOperand& op : templateOperands(dae, ctx, b)) {
+  for (const TemplateOperand& op : operands) {
     sym::Expr d = ctx.diff(block.residual, op.symbol);
     if (d->isZero()) continue;
     if (op.derivative) d = ctx.mul(cj, d);
@@ -146,34 +160,35 @@ JacobianEntries differentiate(const dae::Dae& dae, sym::Context& ctx, sym::Expr 
     for (uint32_t k : symbols) byPosition[k] = ctx.zero();
   }
   std::vector<TemplateEntry> templates;
-  for (size_t b = 0; b < dae.templateBlocks.size(); ++b) templateEntries(dae, ctx, cj, b, templates, entries);
+  std::vector<std::vector<TemplateOperand>> operands = templateOperands(dae, ctx);
+  for (size_t b = 0; b < dae.templateBlocks.size(); ++b) templateEntries(dae, ctx, cj, b, operands[b], templates, entries);
   if (!templates.empty()) entries = sortedByRow(entries, dae.equations.size());
-  return compress(entries, n, std::move(templates));
+  JacobianEntries J = compress(entries, n, std::move(templates));
+  J.templateOperands = std::move(operands);
+  return J;
 }
 
-std::vector<TemplateOperand> templateOperands(const dae::Dae& dae, const sym::Context& ctx, size_t b) {
-  const dae::TemplateBlock& block = dae.templateBlocks[b];
+std::vector<std::vector<TemplateOperand>> templateOperands(const dae::Dae& dae, const sym::Context& ctx) {
+  std::vector<std::vector<TemplateOperand>> out(dae.templateBlocks.size());
+  if (out.empty()) return out;
   std::unordered_map<sym::Expr, std::pair<int, bool>> unknownOf;  // element symbol → variable, is y'
-  std::vector<TemplateOperand> out;
-  for (sym::Expr s : ctx.freeSymbols(block.residual)) {
-    const flat::RelativeElement* rel = dae.patterns->find(s);
-    if (!rel) continue;
-    const flat::ArrayVariable& a = dae.patterns->arrays[rel->array];
-    if (unknownOf.empty())
-      for (int j = 0; j < static_cast<int>(dae.variables.size()); ++j) {
-        unknownOf.emplace(dae.variables[j].y, std::pair{j, false});
-        if (dae.variables[j].yp) unknownOf.emplace(dae.variables[j].yp, std::pair{j, true});
-      }
-    auto it = unknownOf.find(a.elements[0]);
-    if (it == unknownOf.end()) QDOT_UNREACHABLE("a template reads an array that is not of unknowns");
-    for (size_t k = 0; k < a.elements.size(); ++k) {  // element k is unknown j0 + k: what a loop relies on
-      auto e = unknownOf.find(a.elements[k]);
-      if (e == unknownOf.end() || e->second.first != it->second.first + static_cast<int>(k) || e->second.second != it->second.second)
-        QDOT_UNREACHABLE("a template reads an array whose elements are not consecutive unknowns");
+  unknownOf.reserve(2 * dae.variables.size());
+  for (int j = 0; j < static_cast<int>(dae.variables.size()); ++j) {
+    unknownOf.emplace(dae.variables[j].y, std::pair{j, false});
+    if (dae.variables[j].yp) unknownOf.emplace(dae.variables[j].yp, std::pair{j, true});
+  }
+  std::unordered_map<int, std::pair<int, bool>> checked;  // array → its first unknown, once verified
+  for (size_t b = 0; b < out.size(); ++b) {
+    const dae::TemplateBlock& block = dae.templateBlocks[b];
+    for (sym::Expr s : ctx.freeSymbols(block.residual)) {
+      const flat::RelativeElement* rel = dae.patterns->find(s);
+      if (!rel) continue;
+      auto [known, first] = checked.try_emplace(rel->array);
+      if (first) known->second = consecutiveUnknowns(dae.patterns->arrays[rel->array], unknownOf);
+      long offset = 0;
+      for (size_t d = 0; d < rel->dims.size(); ++d) offset = offset * block.shape[d] + rel->dims[d].offset;
+      out[b].push_back({s, known->second.first, known->second.second, offset});
     }
-    long offset = 0;
-    for (size_t d = 0; d < rel->dims.size(); ++d) offset = offset * block.shape[d] + rel->dims[d].offset;
-    out.push_back({s, it->second.first, it->second.second, offset});
   }
   return out;
 }

@@ -32,11 +32,12 @@ struct JacobianEntries {
   std::vector<int32_t> rowIndices;    ///< ascending within each column
   std::vector<sym::Expr> values;      ///< one expression per nonzero, in CSC order (uses the symbol cj); null where a template entry writes
   std::vector<TemplateEntry> templateEntries;
+  std::vector<std::vector<TemplateOperand>> templateOperands;  ///< per template block
 };
 
-/// The relative symbols of block `b` that are unknowns, with where they are read (every relative
-/// symbol of a templated DAE is one: the pipeline keeps templates only then).
-std::vector<TemplateOperand> templateOperands(const dae::Dae& dae, const sym::Context& ctx, size_t b);
+/// Per template block, its relative symbols with where they are read (every relative symbol of a
+/// templated DAE is an unknown's: the pipeline keeps templates only then).
+std::vector<std::vector<TemplateOperand>> templateOperands(const dae::Dae& dae, const sym::Context& ctx);
 
 /// Differentiates every residual with respect to the variables it mentions: one sparse forward pass
 /// (sym::PartialDerivatives), O(Σ over the residuals' nodes of the unknowns each contains).

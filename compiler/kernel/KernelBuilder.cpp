@@ -405,7 +405,7 @@ class Builder {
     std::vector<long> lo;
     for (auto [first, last] : block.region) lo.push_back(first);
     long base = linearIndex(block.shape, lo);
-    std::vector<Operand> operands = templateOperands(dae_, ctx_, k);
+    const std::vector<Operand>& operands = jac.templateOperands[k];
     for (const auto& op : operands)
       b.bindLoopedLoad(op.symbol, op.derivative ? Op::LoadYpLooped : Op::LoadYLooped,
                        static_cast<uint32_t>(op.variable + base + op.offset));
