@@ -4,6 +4,7 @@
 // Every equation keeps its Origin. This is what structural analysis and the kernels consume.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -63,6 +64,26 @@ struct Invariant {
   sym::Expr value = nullptr;
 };
 
+/// Rows of F given by one template (issue 15, docs/loops.md): the rows of the elements of an array
+/// over a box of subscripts. Row of the element with subscripts s: firstRow + linear(s), linear the
+/// row-major index in `shape` (0 for (1, …, 1)); those rows' Equation::residual is null. The
+/// residual is over relative symbols (Dae::patterns) whose arrays have this shape and whose
+/// elements are unknowns in the same order (their y or y' symbols).
+struct TemplateBlock {
+  int firstRow = -1;
+  std::vector<int> shape;
+  std::vector<std::pair<long, long>> region;  ///< per dimension: first and last subscript
+  sym::Expr residual = nullptr;
+  flat::OriginKind origin = flat::OriginKind::EulerLagrange;
+  SourceRange range;  ///< the array's declaration
+
+  size_t pointCount() const {
+    size_t n = 1;
+    for (auto [lo, hi] : region) n *= static_cast<size_t>(hi - lo + 1);
+    return n;
+  }
+};
+
 struct Dae {
   std::string name, description;
   SourceRange range;
@@ -86,6 +107,12 @@ struct Dae {
   /// every row except as many links as there are derivatives of equations, chosen at run time where
   /// the differentiated equations can be solved for them (Mattsson–Söderlind).
   std::vector<std::vector<int>> differentiatedRows;
+  /// Rows kept as templates (only when the equations of motion have template rows) and the
+  /// relative symbols' table they use.
+  std::vector<TemplateBlock> templateBlocks;
+  std::shared_ptr<flat::ElementPatterns> patterns;
+
+  bool templated() const { return !templateBlocks.empty(); }
 
   size_t dummyDerivativeCount() const {
     size_t n = 0;

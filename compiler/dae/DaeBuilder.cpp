@@ -2,7 +2,9 @@
 // adds the kinematic rows q' = der(q), and checks the balance of equations and unknowns.
 #include "dae/Dae.h"
 #include "dae/Balance.h"
+#include "support/Assert.h"
 
+#include <algorithm>
 #include <unordered_map>
 
 namespace qdot::dae {
@@ -36,7 +38,9 @@ class Builder {
       dae_.invariants.push_back({fi.name, fi.kind == mech::FirstIntegral::Kind::Jacobi ? "Jacobi integral" : "cyclic momentum",
                                  substituted(fi.value)});
     if (!aliases_.empty()) substituteRest();
-    if (diags_.errorCount() == errorsBefore) checkBalance(dae_, ctx_, diags_);
+    if (!eom_.templateRows.empty()) addTemplateBlocks();
+    // Template rows are one Euler–Lagrange row per coordinate and its kinematic row by construction.
+    if (diags_.errorCount() == errorsBefore && !dae_.templated()) checkBalance(dae_, ctx_, diags_);
     if (diags_.errorCount() > errorsBefore) return std::nullopt;
     return std::move(dae_);
   }
@@ -73,7 +77,8 @@ class Builder {
   void markAppearances() {
     appears_.assign(ctx_.symbolCount(), 0);
     for (const auto& eq : dae_.equations)
-      for (Expr s : ctx_.freeSymbols(eq.residual)) appears_[s->symbolId] = 1;
+      if (eq.residual)
+        for (Expr s : ctx_.freeSymbols(eq.residual)) appears_[s->symbolId] = 1;
   }
   bool appears(Expr s) const { return s->symbolId < appears_.size() && appears_[s->symbolId]; }
 
@@ -116,7 +121,7 @@ class Builder {
       const flat::Variable& v = m_.variables[q.derivative];
       const flat::Variable& a = m_.variables[v.derivative];
       // Inertia shows as the acceleration in some row (an aliased coordinate's row counts).
-      bool inertial = appears(a.symbol);
+      bool inertial = row.templateRow >= 0 || appears(a.symbol);
       dae_.coordinates.push_back(static_cast<int>(dae_.variables.size()));
       if (!inertial && !appears(v.symbol)) {
         dae_.variables.push_back(fromFlat(row.coordinate, VarKind::Algebraic, UnknownRole::Coordinate));
@@ -181,6 +186,58 @@ class Builder {
     }
     for (const auto& eq : m_.initialEquations)
       dae_.initialEquations.push_back({substituted(eq.residual), eq.origin, substituted(eq.lhs), substituted(eq.rhs)});
+  }
+
+  // --- templates (issue 15) ---
+  // The Euler–Lagrange template rows, and per templated array one template for its kinematic rows
+  // $der(x)[%…] − der(x)[%…] (rows of the same order as its elements').
+  void addTemplateBlocks() {
+    dae_.patterns = m_.patterns;
+    flat::ElementPatterns& patterns = *m_.patterns;
+    std::unordered_map<int, int> rowOfFlat, kinematicRowOfFlat;
+    for (int r = 0; r < static_cast<int>(eom_.rows.size()); ++r) rowOfFlat.emplace(eom_.rows[r].coordinate, r);
+    for (const auto& link : dae_.links) kinematicRowOfFlat.emplace(dae_.variables[link.variable].flatVar, link.row);
+    std::vector<int> arrays;
+    for (const auto& t : eom_.templateRows) {
+      const flat::ArrayVariable& a = patterns.arrays[t.array];
+      int first = rowOfFlat.at(m_.variableOf(a.elements[0]));
+      const flat::Variable& q = m_.variables[m_.variableOf(a.elements[0])];
+      dae_.templateBlocks.push_back({first, a.shape, t.region, t.residual, flat::OriginKind::EulerLagrange, q.declRange});
+      if (std::find(arrays.begin(), arrays.end(), t.array) == arrays.end()) arrays.push_back(t.array);
+    }
+    // Rows in the elements' order is what lets a template address them (coordinates are declared
+    // element by element, so they are).
+    auto inOrder = [&](const std::unordered_map<int, int>& rowOf, const flat::ArrayVariable& a) {
+      auto first = rowOf.find(m_.variableOf(a.elements[0]));
+      for (size_t k = 0; first != rowOf.end() && k < a.elements.size(); ++k) {
+        auto it = rowOf.find(m_.variableOf(a.elements[k]));
+        if (it == rowOf.end() || it->second != first->second + static_cast<int>(k)) return false;
+      }
+      return first != rowOf.end();
+    };
+    for (int x : arrays)
+      if (!inOrder(rowOfFlat, patterns.arrays[x]))
+        QDOT_UNREACHABLE("template rows of an array whose Euler-Lagrange rows are not in element order");
+    for (int x : arrays) {
+      const flat::ArrayVariable a = patterns.arrays[x];
+      if (!inOrder(kinematicRowOfFlat, a)) continue;  // an element without inertia: scalar kinematic rows
+      int first = kinematicRowOfFlat.at(m_.variableOf(a.elements[0]));
+      flat::ArrayVariable rates{"$der(" + a.name + ")", a.shape, {}};
+      for (Expr e : a.elements) {
+        int row = kinematicRowOfFlat.at(m_.variableOf(e));
+        rates.elements.push_back(dae_.variables[dae_.links[row - eom_.rows.size()].variable].yp);
+        dae_.equations[row].residual = nullptr;
+      }
+      patterns.arrays.push_back(std::move(rates));
+      flat::RelativeElement own{static_cast<int>(patterns.arrays.size()) - 1, {}};
+      std::vector<std::pair<long, long>> all;
+      for (size_t d = 0; d < a.shape.size(); ++d) own.dims.push_back({static_cast<int>(d), 0}), all.push_back({1, a.shape[d]});
+      flat::RelativeElement velocity = own;
+      velocity.array = a.derivative;
+      Expr residual = ctx_.sub(patterns.symbol(ctx_, own), patterns.symbol(ctx_, velocity));
+      dae_.templateBlocks.push_back({first, a.shape, all, residual, flat::OriginKind::Kinematic,
+                                     m_.variables[m_.variableOf(a.elements[0])].declRange});
+    }
   }
 
   // The kinematic rows go after the Euler–Lagrange rows (made by addMechanics, which needs to

@@ -3,6 +3,8 @@
 // whether the stage succeeded; continueTo runs the ones not run yet.
 #include "driver/Pipeline.h"
 
+#include <algorithm>
+
 #include <charconv>
 #include <filesystem>
 #include <chrono>
@@ -60,8 +62,33 @@ bool check(Compilation& c) {
   return c.checked && !c.diags.hasErrors();
 }
 
+// Where the stages after flattening take templates (docs/loops.md): a model of energies over
+// coordinates only — no equations, constraints, components or aliases (their structural passes
+// work on scalars) — and a run that needs no invariants (a sum over every element).
+// The loops read unknowns only: a template over an array of parameters (masses[i]) stays scalar.
+bool templatesApply(const flat::FlatModel& m, const CompileOptions& o, const sym::Context& ctx) {
+  if (!o.keepLoops || m.indexedSums.empty() || o.keepInvariants) return false;
+  if (!m.equations.empty() || !m.initialEquations.empty() || !m.constraints.empty() || m.components.size() > 1) return false;
+  bool plain = std::none_of(m.variables.begin(), m.variables.end(), [](const flat::Variable& v) {
+    return v.alias || v.role == flat::VarRole::Unknown || v.role == flat::VarRole::Derivative;
+  });
+  for (const flat::IndexedSum& sum : m.indexedSums)
+    for (sym::Expr s : ctx.freeSymbols(sum.body))
+      if (const flat::RelativeElement* rel = m.relativeElement(s)) {
+        int var = m.variableOf(m.patterns->arrays[rel->array].elements[0]);
+        plain = plain && var >= 0 && (m.variables[var].role == flat::VarRole::Coordinate || m.variables[var].role == flat::VarRole::Velocity);
+      }
+  return plain;
+}
+
 bool flatten(Compilation& c) {
-  c.flat = timed(c.times.flatten, [&] { return flat::flatten(*c.checked, c.ctx, c.diags, c.options.limits, c.options.structural); });
+  c.flat = timed(c.times.flatten, [&] {
+    flat::FlattenLimits limits = c.options.limits;
+    limits.keepLoops = true;
+    auto model = flat::flatten(*c.checked, c.ctx, c.diags, limits, c.options.structural);
+    if (model && !templatesApply(*model, c.options, c.ctx)) flat::expandIndexedSums(*model, c.ctx);
+    return model;
+  });
   return c.flat && !c.diags.hasErrors();
 }
 
@@ -73,6 +100,9 @@ bool derive(Compilation& c) {
 bool buildDae(Compilation& c) {
   c.dae = timed(c.times.dae, [&] {
     std::optional<dae::Dae> d = dae::buildDae(*c.flat, *c.eom, c.ctx, c.diags);
+    // A templated DAE is an ODE in the accelerations of one row per coordinate (index 1), and its
+    // coordinates are coupled along the arrays: nothing to reduce, nothing worth pruning.
+    if (d && d->templated()) return d;
     if (d && !c.options.results.empty()) {
       std::vector<std::string> names = c.options.results;
       if (c.options.keepInvariants)

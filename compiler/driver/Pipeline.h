@@ -53,6 +53,9 @@ struct CompileOptions {
   /// everything. keepInvariants keeps every invariant (and what it needs) as well (`--invariants`).
   std::vector<std::string> results;
   bool keepInvariants = false;
+  /// Keep repeated structure as templates and loops where the model allows it (docs/loops.md):
+  /// `qdot run`. Elsewhere (equations, modes, …) every sum is expanded.
+  bool keepLoops = false;
 };
 
 /// Everything one compilation creates; later stages point into earlier ones, so it is not

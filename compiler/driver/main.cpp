@@ -79,6 +79,8 @@ std::optional<ExitCode> compileToKernels(driver::Compilation& c, Options& o) {
 // --emit=STAGE: compile up to the stage, print its output, stop.
 ExitCode emitStage(driver::Compilation& c, Options& o) {
   driver::EmitStage stage = *driver::parseEmitStage(o.emit);
+  // What `qdot run` compiles, loops included, where the stage shown is past the DAE.
+  c.options.keepLoops = driver::stageNeeded(stage) >= driver::Stage::Kernel;
   ExitCode failure;
   bool ok = compileTo(c, o, driver::stageNeeded(stage), failure) && driver::emit(c, stage, std::cout);
   if (!ok && failure == ExitCode::Usage) return failure;
@@ -148,7 +150,8 @@ driver::Backend backendOf(const Options& o) {
 // qdot run: compile (only what --outputs needs), simulate, write the CSV.
 ExitCode run(driver::Compilation& c, Options& o) {
   c.options.results = o.run.outputs;
-  if (!o.run.outputs.empty() && o.run.invariants) c.options.keepInvariants = true;
+  c.options.keepInvariants = o.run.invariants;
+  c.options.keepLoops = true;
   if (std::optional<ExitCode> failed = compileToKernels(c, o)) return *failed;
   driver::RunnableModel m = driver::makeRunnableModel(c, backendOf(o), o.run.invariants);
   if (!m.model) {

@@ -36,6 +36,7 @@ Expr Flattener::timeDerivative(Expr e, SourceRange where) {
 // The rate function of timeDerivative_, bound once (binding a new closure per der() call cost a heap
 // block each); the current call's location comes from derivativeSite_.
 Expr Flattener::rateOf(Expr s) {
+  if (const RelativeElement* rel = out_.relativeElement(s)) return rateOfRelative(*rel);
   int var = out_.variableOf(s);
   if (var < 0 || out_.variables[var].role == VarRole::Parameter) return ctx_.zero();
   if (out_.variables[var].role == VarRole::Time) return ctx_.one();

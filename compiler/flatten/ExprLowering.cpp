@@ -147,6 +147,8 @@ const Value& Flattener::subscriptBase(const ast::Expr& e, Value& holder) {
 }
 
 Value Flattener::lowerIndex(const IndexExpr& e) {
+  if (!templateIterators_.empty())
+    if (std::optional<Value> relative = lowerRelativeIndex(e)) return std::move(*relative);
   Value holder;
   const Value& base = subscriptBase(*e.base, holder);
   if (e.subscripts.size() != base.shape.size())

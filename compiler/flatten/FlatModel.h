@@ -7,9 +7,12 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include "support/SourceManager.h"
@@ -95,6 +98,69 @@ struct Output {
   OutputKind kind = OutputKind::Plain;
 };
 
+/// An array kept whole so that repeated structure stays repeated (issue 15, docs/loops.md): its
+/// elements, row-major, are still scalar expressions (a declared variable's are its variables'
+/// symbols). `derivative` is the array of the elements' der() (-1 until it is needed).
+struct ArrayVariable {
+  std::string name;  ///< the declaration's name: "x", "der(x)"
+  std::vector<int> shape;
+  std::vector<sym::Expr> elements;
+  int derivative = -1;
+};
+
+/// What a relative symbol such as `x[%1+1]` stands for inside a template: the element of array
+/// `array` whose subscript in dimension d is (value of iterator dims[d].iterator) + dims[d].offset,
+/// or the constant dims[d].offset when that iterator is -1. Subscripts are 1-based.
+struct RelativeElement {
+  struct Dim {
+    int iterator = -1;
+    int offset = 0;
+  };
+  int array = -1;
+  std::vector<Dim> dims;
+};
+
+/// The arrays templates index and their relative symbols: an interning table beside the symbolic
+/// Context. Later stages add the patterns they derive (shifted offsets, derivatives) as they add
+/// nodes to the Context, so the FlatModel holds it by shared pointer.
+class ElementPatterns {
+ public:
+  std::vector<ArrayVariable> arrays;
+
+  /// The relative symbol of a pattern, named after it ("x[%1+1]", "z[1,%2]"); made on first use.
+  sym::Expr symbol(sym::Context& ctx, const RelativeElement& rel);
+  /// The pattern a symbol stands for, or nullptr.
+  const RelativeElement* find(sym::Expr s) const {
+    if (elements_.empty() || !s->isSymbol()) return nullptr;
+    auto it = elements_.find(s->symbolId);
+    return it == elements_.end() ? nullptr : &it->second;
+  }
+  /// The element a relative symbol stands for at a point of its template's iterators.
+  sym::Expr elementAt(const RelativeElement& rel, std::span<const long> point) const;
+
+ private:
+  std::unordered_map<uint32_t, RelativeElement> elements_;  ///< by symbolId
+};
+
+/// `sum(body for i in a:b, j in c:d)` in an energy, kept as one template instead of one term per
+/// element: Σ over the box of iterator values of `body`, an expression over parameters, time, plain
+/// variables and relative symbols (the iterators appear only in subscripts).
+/// The sum is a summand of kinetic/potential/dissipation[term] (which holds the other summands).
+struct IndexedSum {
+  enum class Energy : uint8_t { Kinetic, Potential, Dissipation };
+  Energy energy = Energy::Kinetic;
+  int term = -1;
+  std::vector<std::pair<long, long>> box;  ///< per iterator: first and last value (inclusive)
+  sym::Expr body = nullptr;
+  SourceRange range;  ///< the sum(...) call
+
+  size_t pointCount() const {
+    size_t n = 1;
+    for (auto [lo, hi] : box) n *= hi >= lo ? static_cast<size_t>(hi - lo + 1) : 0;
+    return n;
+  }
+};
+
 struct Experiment {
   std::optional<double> startTime, stopTime, interval, tolerance;
 };
@@ -111,6 +177,10 @@ struct FlatModel {
   std::vector<std::pair<int, Term>> forces;  ///< (coordinate variable, term)
   std::vector<Equation> constraints;         ///< g(q, t) = 0, origin.range = the statement
   std::vector<Output> outputs;
+  /// Repeated structure kept as templates (only when flattened with FlattenLimits::keepLoops; see
+  /// expandIndexedSums): the sums, the arrays their relative symbols index, and those symbols.
+  std::vector<IndexedSum> indexedSums;
+  std::shared_ptr<ElementPatterns> patterns = std::make_shared<ElementPatterns>();
   /// The component instances, by path ("m1", "ms[2]", "sys.m1"); [0] is the model itself ("").
   std::vector<std::string> components;
   /// Components' connectors joined to nothing (their flows are 0), by path, with the component's
@@ -133,6 +203,8 @@ struct FlatModel {
   int variableOf(sym::Expr s) const {
     return s->isSymbol() && s->symbolId < symbolToVariable.size() ? symbolToVariable[s->symbolId] : -1;
   }
+  /// The relative element a symbol stands for, or nullptr.
+  const RelativeElement* relativeElement(sym::Expr s) const { return patterns->find(s); }
   std::vector<int> variablesWithRole(VarRole r) const {
     std::vector<int> out;
     for (int i = 0; i < static_cast<int>(variables.size()); ++i)

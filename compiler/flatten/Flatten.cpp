@@ -475,6 +475,7 @@ void Flattener::lowerMechanics(const MechanicsStmt& st) {
 void Flattener::addTerms(std::vector<Term>& into, const MechanicsStmt& st) {
   const char* what = st.kind == MechanicsKind::Kinetic ? "a kinetic energy"
                      : st.kind == MechanicsKind::Potential ? "a potential energy" : "a dissipation function";
+  if (limits_.keepLoops) return addTermsKeepingLoops(into, st, what);
   into.push_back({lowerScalar(*st.value, what), st.range});
 }
 

@@ -4,6 +4,7 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
 
 #include "flatten/FlatModel.h"
@@ -16,6 +17,9 @@ namespace qdot::flat {
 /// Limits that keep hostile input from exhausting memory (a clear error instead).
 struct FlattenLimits {
   size_t maxScalars = 20'000'000;  ///< total scalar elements across all arrays and loops
+  /// Keep `sum(... for i in a:b)` in energies as IndexedSums (templates) where its body indexes
+  /// arrays by the iterator plus constants (docs/loops.md); otherwise every sum is expanded.
+  bool keepLoops = false;
 };
 
 /// Values that replace the bindings of scalar Integer parameters (`qdot run -p n=3`): the model
@@ -27,5 +31,13 @@ using StructuralValues = std::map<std::string, long, std::less<>>;
 /// builds T, V, D, forces and equations. Returns nullopt if errors were reported.
 std::optional<FlatModel> flatten(const sema::CheckedModel& model, sym::Context& ctx, DiagnosticEngine& diags,
                                  FlattenLimits limits = {}, const StructuralValues& structural = {});
+
+/// The body of a template at one point of its iterators' box: iterator symbols become the point's
+/// values, relative symbols the elements they stand for. `point` has one value per iterator.
+sym::Expr instantiate(const FlatModel& model, sym::Context& ctx, sym::Expr body, std::span<const long> point);
+
+/// Expands every IndexedSum into its energy term (the model then is what flattening without
+/// keepLoops gives) and clears the templates.
+void expandIndexedSums(FlatModel& model, sym::Context& ctx);
 
 }  // namespace qdot::flat

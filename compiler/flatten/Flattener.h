@@ -162,6 +162,18 @@ struct AliasEquation {
   bool ofPotential = false;  ///< a connector's potential's (spec §7), not between plain unknowns
 };
 
+/// An iterator of a sum lowered as a template (IndexedSums.cpp) and its range.
+struct TemplateIterator {
+  std::string name;
+  long first = 0, last = 0;
+};
+
+/// A top-level summand of an energy statement and its sign.
+struct Summand {
+  const ast::Expr* expr;
+  bool negated;
+};
+
 class Flattener {
  public:
   Flattener(const sema::CheckedModel& m, sym::Context& ctx, DiagnosticEngine& diags, FlattenLimits limits,
@@ -266,6 +278,18 @@ class Flattener {
   void addTerms(std::vector<Term>& into, const ast::MechanicsStmt& st);
   void lowerForce(const ast::MechanicsStmt& st);
   void lowerExperiment();
+
+  // IndexedSums.cpp (FlattenLimits::keepLoops)
+  void addTermsKeepingLoops(std::vector<Term>& into, const ast::MechanicsStmt& st, const char* what);
+  bool lowerIndexedSum(const ast::CallExpr& call, bool negated, IndexedSum& sum);
+  std::optional<Value> lowerRelativeIndex(const ast::IndexExpr& e);
+  sym::Expr relativeSymbol(const RelativeElement& rel);
+  int arrayOf(const Value& declared, const std::string& name);
+  long plainInteger(const ast::Expr& e);
+  sym::Expr rateOfRelative(const RelativeElement& rel);
+  std::vector<TemplateIterator> templateIterators_;  ///< of the sum being lowered as a template
+  std::map<const Value*, int> arrayIds_;             ///< declared arrays met in templates
+
   void forEachIteration(const std::vector<ast::Iterator>& its, size_t k, const std::function<void()>& body);
   template <class F> void guarded(F&& body);
 
@@ -299,6 +323,7 @@ class Flattener {
   Value lowerFunctionName(const ast::NameExpr& n);
 
   friend struct IteratorScope;
+  friend class TemplateCheck;
   friend class ScopeGuard;
   friend class FrameGuard;
 };

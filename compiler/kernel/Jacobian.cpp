@@ -3,6 +3,10 @@
 // on, not to n² (nor to n per symbol, as Context::diff would be once symbols alias in the mask).
 #include "kernel/Jacobian.h"
 
+#include <algorithm>
+#include <unordered_map>
+
+#include "support/Assert.h"
 #include "symbolic/NodeMap.h"
 
 namespace qdot::kernel {
@@ -34,11 +38,24 @@ struct Unknowns {
 struct Entry {
   int32_t row, column;
   sym::Expr value;
+  int32_t templateEntry = -1;  // ≥ 0: JacobianEntries::templateEntries[templateEntry] at point `point`
+  uint32_t point = 0;
 };
 
+// Row order (stable) by counting: template entries come block by block, not in row order.
+std::vector<Entry> sortedByRow(const std::vector<Entry>& entries, size_t rows) {
+  std::vector<uint32_t> start(rows + 1, 0);
+  for (const Entry& e : entries) ++start[e.row + 1];
+  for (size_t r = 0; r < rows; ++r) start[r + 1] += start[r];
+  std::vector<Entry> sorted(entries.size());
+  for (const Entry& e : entries) sorted[start[e.row]++] = e;
+  return sorted;
+}
+
 // CSC order from entries that are already in row order: a stable counting sort by column.
-JacobianEntries compress(const std::vector<Entry>& entries, size_t columns) {
+JacobianEntries compress(const std::vector<Entry>& entries, size_t columns, std::vector<TemplateEntry> templates) {
   JacobianEntries J;
+  J.templateEntries = std::move(templates);
   J.columnStarts.assign(columns + 1, 0);
   for (const Entry& e : entries) ++J.columnStarts[e.column + 1];
   for (size_t j = 0; j < columns; ++j) J.columnStarts[j + 1] += J.columnStarts[j];
@@ -49,8 +66,59 @@ JacobianEntries compress(const std::vector<Entry>& entries, size_t columns) {
     int32_t at = next[e.column]++;
     J.rowIndices[at] = e.row;
     J.values[at] = e.value;
+    if (e.templateEntry >= 0) J.templateEntries[e.templateEntry].positions[e.point] = static_cast<uint32_t>(at);
   }
   return J;
+}
+
+size_t linear(const std::vector<int>& shape, std::span<const long> subscripts) {
+  size_t k = 0;
+  for (size_t d = 0; d < shape.size(); ++d) k = k * shape[d] + static_cast<size_t>(subscripts[d] - 1);
+  return k;
+}
+
+// The unknown of an array's first element; element k must be the unknown after it by k (the loops
+// address them so).
+std::pair<int, bool> consecutiveUnknowns(const flat::ArrayVariable& a,
+                                         const std::unordered_map<sym::Expr, std::pair<int, bool>>& unknownOf) {
+  auto it = unknownOf.find(a.elements[0]);
+  if (it == unknownOf.end()) QDOT_UNREACHABLE("a template reads an array that is not of unknowns");
+  for (size_t k = 0; k < a.elements.size(); ++k) {
+    auto e = unknownOf.find(a.elements[k]);
+    if (e == unknownOf.end() || e->second.first != it->second.first + static_cast<int>(k) || e->second.second != it->second.second)
+      QDOT_UNREACHABLE("a template reads an array whose elements are not consecutive unknowns");
+  }
+  return it->second;
+}
+
+// The entries of block b: ∂F/∂y + cj ∂F/∂y' per column pattern, then one Entry per point.
+void templateEntries(const dae::Dae& dae, sym::Context& ctx, sym::Expr cj, size_t b, std::span<const TemplateOperand> operands,
+                     std::vector<TemplateEntry>& out, std::vector<Entry>& entries) {
+  const dae::TemplateBlock& block = dae.templateBlocks[b];
+  size_t first = out.size();
+  for (const TemplateOperand& op : operands) {
+    sym::Expr d = ctx.diff(block.residual, op.symbol);
+    if (d->isZero()) continue;
+    if (op.derivative) d = ctx.mul(cj, d);
+    auto same = std::find_if(out.begin() + static_cast<long>(first), out.end(),
+                             [&](const TemplateEntry& e) { return e.variable == op.variable && e.offset == op.offset; });
+    if (same != out.end()) same->value = ctx.add(same->value, d);
+    else out.push_back({static_cast<int>(b), d, op.variable, op.offset, {}});
+  }
+  size_t points = block.pointCount();
+  for (size_t e = first; e < out.size(); ++e) out[e].positions.resize(points);
+  std::vector<long> p;
+  for (auto [lo, hi] : block.region) p.push_back(lo);
+  for (uint32_t c = 0; c < points; ++c) {
+    auto at = static_cast<long>(linear(block.shape, p));
+    for (size_t e = first; e < out.size(); ++e)
+      entries.push_back({static_cast<int32_t>(block.firstRow + at), static_cast<int32_t>(out[e].variable + at + out[e].offset),
+                         nullptr, static_cast<int32_t>(e), c});
+    for (size_t d = p.size(); d-- > 0;) {
+      if (++p[d] <= block.region[d].second) break;
+      p[d] = block.region[d].first;
+    }
+  }
 }
 
 }  // namespace
@@ -73,6 +141,7 @@ JacobianEntries differentiate(const dae::Dae& dae, sym::Context& ctx, sym::Expr 
   std::vector<char> seen(n, 0);
   for (size_t i = 0; i < dae.equations.size(); ++i) {
     sym::Expr f = dae.equations[i].residual;
+    if (!f) continue;  // a template block's row
     std::span<const sym::Expr> gradient = partial.gradient(f);
     std::span<const uint32_t> symbols = partial.symbolsIn(f);
     candidates.clear();
@@ -90,7 +159,38 @@ JacobianEntries differentiate(const dae::Dae& dae, sym::Context& ctx, sym::Expr 
     }
     for (uint32_t k : symbols) byPosition[k] = ctx.zero();
   }
-  return compress(entries, n);
+  std::vector<TemplateEntry> templates;
+  std::vector<std::vector<TemplateOperand>> operands = templateOperands(dae, ctx);
+  for (size_t b = 0; b < dae.templateBlocks.size(); ++b) templateEntries(dae, ctx, cj, b, operands[b], templates, entries);
+  if (!templates.empty()) entries = sortedByRow(entries, dae.equations.size());
+  JacobianEntries J = compress(entries, n, std::move(templates));
+  J.templateOperands = std::move(operands);
+  return J;
+}
+
+std::vector<std::vector<TemplateOperand>> templateOperands(const dae::Dae& dae, const sym::Context& ctx) {
+  std::vector<std::vector<TemplateOperand>> out(dae.templateBlocks.size());
+  if (out.empty()) return out;
+  std::unordered_map<sym::Expr, std::pair<int, bool>> unknownOf;  // element symbol → variable, is y'
+  unknownOf.reserve(2 * dae.variables.size());
+  for (int j = 0; j < static_cast<int>(dae.variables.size()); ++j) {
+    unknownOf.emplace(dae.variables[j].y, std::pair{j, false});
+    if (dae.variables[j].yp) unknownOf.emplace(dae.variables[j].yp, std::pair{j, true});
+  }
+  std::unordered_map<int, std::pair<int, bool>> checked;  // array → its first unknown, once verified
+  for (size_t b = 0; b < out.size(); ++b) {
+    const dae::TemplateBlock& block = dae.templateBlocks[b];
+    for (sym::Expr s : ctx.freeSymbols(block.residual)) {
+      const flat::RelativeElement* rel = dae.patterns->find(s);
+      if (!rel) continue;
+      auto [known, first] = checked.try_emplace(rel->array);
+      if (first) known->second = consecutiveUnknowns(dae.patterns->arrays[rel->array], unknownOf);
+      long offset = 0;
+      for (size_t d = 0; d < rel->dims.size(); ++d) offset = offset * block.shape[d] + rel->dims[d].offset;
+      out[b].push_back({s, known->second.first, known->second.second, offset});
+    }
+  }
+  return out;
 }
 
 }  // namespace qdot::kernel

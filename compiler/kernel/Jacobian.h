@@ -7,11 +7,37 @@
 
 namespace qdot::kernel {
 
+/// How a relative symbol of a template block is read: the unknown of its array's element with
+/// linear index 0 (y or y'), and the linear offset of its pattern (Σ offset_d · stride_d).
+struct TemplateOperand {
+  sym::Expr symbol = nullptr;
+  int variable = -1;
+  bool derivative = false;  ///< y' (else y)
+  long offset = 0;
+};
+
+/// One entry of a template block's rows: the value (over the block's relative symbols and cj) at
+/// column variable + linear(row's subscripts) + offset, and its CSC position per point of the
+/// block's region (row-major order, the order of the loop).
+struct TemplateEntry {
+  int block = -1;
+  sym::Expr value = nullptr;
+  int variable = -1;
+  long offset = 0;
+  std::vector<uint32_t> positions;
+};
+
 struct JacobianEntries {
   std::vector<int32_t> columnStarts;  ///< [nVariables + 1]
   std::vector<int32_t> rowIndices;    ///< ascending within each column
-  std::vector<sym::Expr> values;      ///< one expression per nonzero, in CSC order (uses the symbol cj)
+  std::vector<sym::Expr> values;      ///< one expression per nonzero, in CSC order (uses the symbol cj); null where a template entry writes
+  std::vector<TemplateEntry> templateEntries;
+  std::vector<std::vector<TemplateOperand>> templateOperands;  ///< per template block
 };
+
+/// Per template block, its relative symbols with where they are read (every relative symbol of a
+/// templated DAE is an unknown's: the pipeline keeps templates only then).
+std::vector<std::vector<TemplateOperand>> templateOperands(const dae::Dae& dae, const sym::Context& ctx);
 
 /// Differentiates every residual with respect to the variables it mentions: one sparse forward pass
 /// (sym::PartialDerivatives), O(Σ over the residuals' nodes of the unknowns each contains).

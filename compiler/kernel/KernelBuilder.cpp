@@ -349,16 +349,20 @@ class Builder {
     m_.description.jacobianColumnStarts = jac.columnStarts;
     m_.description.jacobianRowIndices = jac.rowIndices;
     std::vector<Expr> roots;
-    for (const auto& e : dae_.equations) roots.push_back(e.residual);
+    std::vector<uint32_t> rows, entries;  // the rows and Jacobian entries the roots are (template ones are not)
+    for (uint32_t i = 0; i < dae_.equations.size(); ++i)
+      if (dae_.equations[i].residual) roots.push_back(dae_.equations[i].residual), rows.push_back(i);
     for (size_t k = 0; k < initialRows_.size(); ++k) {  // after every DAE row: rows used only at t0
       const auto& e = initialRows_[k];
       auto row = static_cast<int32_t>(dae_.equations.size() + k);
       m_.description.initialRows.push_back(row);
       m_.description.initialRowLabels.push_back("initial equation " + equationText(e));
       equationSource_.push_back(addSource("initial equation (t0 only)", e.origin.range, equationText(e)));
-      roots.push_back(e.residual);
+      roots.push_back(e.residual), rows.push_back(static_cast<uint32_t>(row));
     }
-    roots.insert(roots.end(), jac.values.begin(), jac.values.end());
+    size_t rowRoots = roots.size();
+    for (uint32_t k = 0; k < jac.values.size(); ++k)
+      if (jac.values[k]) roots.push_back(jac.values[k]), entries.push_back(k);
     roots = sym::expandAngleDifferences(ctx_, roots);  // sin/cos of each angle once, shared
     sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, roots, "$t");
     m_.sharedTemporaries = cse.temporaries.size();
@@ -367,18 +371,103 @@ class Builder {
     ProgramBuilder res(programName(ModelProgram::Residual));
     bindInputs(res, true);
     for (const auto& [t, value] : cse.temporaries) res.bindTemporary(t, value);
-    for (uint32_t i = 0; i < n; ++i) res.setSource(equationSource_[i]), res.store(i, res.lower(cse.outputs[i]));
+    for (size_t k = 0; k < rowRoots; ++k) res.setSource(equationSource_[rows[k]]), res.store(rows[k], res.lower(cse.outputs[k]));
+    for (size_t b = 0; b < dae_.templateBlocks.size(); ++b) emitBlock(res, b, jac, false);
     reportUnbound(res, "residual", "declare it as a variable or a parameter");
     m_.program(ModelProgram::Residual) = res.finish(static_cast<uint32_t>(n));
 
     ProgramBuilder jb(programName(ModelProgram::Jacobian));
     bindInputs(jb, true, cj);
     for (const auto& [t, value] : cse.temporaries) jb.bindTemporary(t, value);
-    for (uint32_t k = 0; k < jac.values.size(); ++k) {
-      jb.setSource(equationSource_[jac.rowIndices[k]]);
-      jb.store(k, jb.lower(cse.outputs[n + k]));
+    for (size_t k = 0; k < entries.size(); ++k) {
+      jb.setSource(equationSource_[jac.rowIndices[entries[k]]]);
+      jb.store(entries[k], jb.lower(cse.outputs[rowRoots + k]));
     }
+    for (size_t b = 0; b < dae_.templateBlocks.size(); ++b) emitBlock(jb, b, jac, true);
     m_.program(ModelProgram::Jacobian) = jb.finish(static_cast<uint32_t>(jac.values.size()));
+  }
+
+  // --- template blocks (issue 15, docs/loops.md) ---------------------------------------------------
+
+  // One loop over block b's region: its rows (residual) or its Jacobian entries, each stored at its
+  // CSC position through an index table. The block's own CSE; temporaries that read no relative
+  // symbol (parameters only) are computed once before the loop.
+  void emitBlock(ProgramBuilder& b, size_t k, const JacobianEntries& jac, bool jacobian) {
+    const dae::TemplateBlock& block = dae_.templateBlocks[k];
+    std::vector<Expr> roots;
+    std::vector<const TemplateEntry*> entries;
+    if (!jacobian) roots.push_back(block.residual);
+    for (const TemplateEntry& e : jac.templateEntries)
+      if (jacobian && e.block == static_cast<int>(k)) roots.push_back(e.value), entries.push_back(&e);
+    if (roots.empty()) return;
+    sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, roots, "$b" + std::to_string(k) + (jacobian ? "j" : "r"));
+    b.setSource(blockSource(k));
+    std::vector<long> lo;
+    for (auto [first, last] : block.region) lo.push_back(first);
+    long base = linearIndex(block.shape, lo);
+    const std::vector<Operand>& operands = jac.templateOperands[k];
+    for (const auto& op : operands)
+      b.bindLoopedLoad(op.symbol, op.derivative ? Op::LoadYpLooped : Op::LoadYLooped,
+                       static_cast<uint32_t>(op.variable + base + op.offset));
+    for (const auto& [t, value] : cse.temporaries) b.bindTemporary(t, value);
+    for (Expr t : invariantTemporaries(cse, operands)) b.lower(t);
+    b.beginLoop(loopOver(b, block, base));
+    if (!jacobian) b.storeLooped(static_cast<uint32_t>(block.firstRow + base), b.lower(cse.outputs[0]));
+    for (size_t e = 0; e < entries.size(); ++e) b.storeIndexed(b.appendIndexTable(entries[e]->positions), b.lower(cse.outputs[e]));
+    b.endLoop();
+  }
+
+  using Operand = TemplateOperand;
+
+  // Row-major points of the region as offsets from its first point: an affine loop in one
+  // dimension, a table of offsets in more.
+  static Loop loopOver(ProgramBuilder& b, const dae::TemplateBlock& block, long base) {
+    Loop loop;
+    loop.count = static_cast<uint32_t>(block.pointCount());
+    if (block.region.size() == 1) return loop;
+    std::vector<uint32_t> offsets;
+    offsets.reserve(loop.count);
+    std::vector<long> p;
+    for (auto [first, last] : block.region) p.push_back(first);
+    for (uint32_t c = 0; c < loop.count; ++c) {
+      offsets.push_back(static_cast<uint32_t>(linearIndex(block.shape, p) - base));
+      for (size_t d = p.size(); d-- > 0;) {
+        if (++p[d] <= block.region[d].second) break;
+        p[d] = block.region[d].first;
+      }
+    }
+    loop.offsetTable = b.appendIndexTable(offsets);
+    return loop;
+  }
+
+  static long linearIndex(const std::vector<int>& shape, const std::vector<long>& subscripts) {
+    long k = 0;
+    for (size_t d = 0; d < shape.size(); ++d) k = k * shape[d] + (subscripts[d] - 1);
+    return k;
+  }
+
+  // The temporaries whose values read no relative symbol, directly or through other temporaries
+  // (CSE lists a temporary after those it uses).
+  std::vector<Expr> invariantTemporaries(const sym::CseResult& cse, const std::vector<Operand>& operands) {
+    std::unordered_set<Expr> variant;
+    for (const auto& op : operands) variant.insert(op.symbol);
+    std::vector<Expr> invariant;
+    for (const auto& [t, value] : cse.temporaries) {
+      bool reads = false;
+      for (Expr s : ctx_.freeSymbols(value)) reads = reads || variant.count(s);
+      if (reads) variant.insert(t);
+      else invariant.push_back(t);
+    }
+    return invariant;
+  }
+
+  uint32_t blockSource(size_t k) {
+    const dae::TemplateBlock& block = dae_.templateBlocks[k];
+    std::string what = block.origin == flat::OriginKind::Kinematic ? "velocities" : "Euler-Lagrange equations";
+    std::string region;
+    for (auto [first, last] : block.region)
+      region += (region.empty() ? "" : ", ") + std::to_string(first) + (last > first ? ":" + std::to_string(last) : "");
+    return addSource(what + " of elements [" + region + "] (one loop)", block.range);
   }
 
   dae::Dae withInitialRows() const {

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <span>
+
+#include "flatten/Flatten.h"
 #include <utility>
 
 namespace qdot::mech {
@@ -50,12 +52,15 @@ class Deriver {
 
   std::optional<EquationsOfMotion> run() {
     size_t errorsBefore = diags_.errorCount();
-    index(lagrangian_, m_.kinetic, 1.0);
-    index(lagrangian_, m_.potential, -1.0);
-    index(dissipation_, m_.dissipation, 1.0);
+    std::vector<flat::Term> kinetic = m_.kinetic, potential = m_.potential, dissipation = m_.dissipation;
+    if (!m_.indexedSums.empty()) expandScalarSums(kinetic, potential, dissipation);
+    index(lagrangian_, kinetic, 1.0);
+    index(lagrangian_, potential, -1.0);
+    index(dissipation_, dissipation, 1.0);
     lagrangian_.finish(m_.variables.size());
     dissipation_.finish(m_.variables.size());
     makeMultipliers();
+    if (!m_.indexedSums.empty()) deriveTemplates();
     for (int q : m_.variablesWithRole(VarRole::Coordinate)) derive(q);
     if (diags_.errorCount() > errorsBefore) return std::nullopt;
     findFirstIntegrals();
@@ -190,11 +195,105 @@ class Deriver {
     return (*timeDerivative_)(e);
   }
 
+  // --- templates (issue 15, TemplateRows.h) ---
+  std::vector<int> templateOf_;  ///< by flat variable: the template row of its element, or -1
+  std::vector<Expr> extraMomentum_, extraPosition_, extraDissipation_;  ///< by flat variable: peeled contributions
+  bool templated_ = false;
+
+  // Sums that cannot give template rows become the scalar terms flattening would have made.
+  void expandScalarSums(std::vector<flat::Term>& kinetic, std::vector<flat::Term>& potential,
+                        std::vector<flat::Term>& dissipation) {
+    for (int s : sumsWithoutTemplates(m_, ctx_)) {
+      const flat::IndexedSum& sum = m_.indexedSums[s];
+      auto& terms = sum.energy == flat::IndexedSum::Energy::Kinetic     ? kinetic
+                    : sum.energy == flat::IndexedSum::Energy::Potential ? potential
+                                                                        : dissipation;
+      std::vector<Expr> parts;
+      forEachPoint(sum.box, [&](std::span<const long> point) { parts.push_back(flat::instantiate(m_, ctx_, sum.body, point)); });
+      terms[sum.term].value = ctx_.add(terms[sum.term].value, ctx_.add(parts));
+      scalarSums_.push_back(s);
+    }
+  }
+  std::vector<int> scalarSums_;
+
+  template <class F>
+  static void forEachPoint(const std::vector<std::pair<long, long>>& box, F&& f) {
+    std::vector<long> point;
+    for (auto [lo, hi] : box) {
+      if (hi < lo) return;
+      point.push_back(lo);
+    }
+    while (true) {
+      f(std::span<const long>(point));
+      size_t d = point.size();
+      while (d > 0 && ++point[d - 1] > box[d - 1].second) point[d - 1] = box[d - 1].first, --d;
+      if (d == 0) return;
+    }
+  }
+
+  // Coordinates that occur in scalar terms, forces or constraints keep scalar rows (peeled).
+  std::vector<char> peeledCoordinates() const {
+    std::vector<char> peeled(m_.variables.size(), 0);
+    for (int q : m_.variablesWithRole(VarRole::Coordinate)) {
+      int v = m_.variables[q].derivative;
+      peeled[q] = !lagrangian_.termsOf(q).empty() || !lagrangian_.termsOf(v).empty() || !dissipation_.termsOf(v).empty() ||
+                  !forces_[q].empty() || !m_.constraints.empty() || m_.variables[q].alias;
+    }
+    return peeled;
+  }
+
+  void deriveTemplates() {
+    TemplateDerivation t = deriveTemplateRows(m_, ctx_, peeledCoordinates(), level_);
+    templated_ = true;
+    templateOf_.assign(m_.variables.size(), -1);
+    const auto& arrays = m_.patterns->arrays;
+    for (int r = 0; r < static_cast<int>(t.rows.size()); ++r) {
+      const auto& a = arrays[t.rows[r].array];
+      forEachPoint(t.rows[r].region, [&](std::span<const long> point) {
+        templateOf_[m_.variableOf(a.elements[linear(a.shape, point)])] = r;
+      });
+    }
+    // Peeled elements and regions of one element: their contributions, instantiated.
+    extraMomentum_.assign(m_.variables.size(), nullptr);
+    extraPosition_.assign(m_.variables.size(), nullptr);
+    extraDissipation_.assign(m_.variables.size(), nullptr);
+    std::vector<std::vector<Expr>> momentum(m_.variables.size()), position(m_.variables.size()), dissipation(m_.variables.size());
+    for (const Contribution& c : t.contributions) {
+      const auto& a = arrays[c.array];
+      forEachPoint(c.box, [&](std::span<const long> point) {
+        int q = m_.variableOf(a.elements[linear(a.shape, point)]);
+        if (templateOf_[q] >= 0) return;
+        auto& into = c.part == Contribution::Part::Momentum ? momentum : c.part == Contribution::Part::Position ? position : dissipation;
+        into[q].push_back(flat::instantiate(m_, ctx_, c.value, point));
+      });
+    }
+    for (size_t q = 0; q < m_.variables.size(); ++q) {
+      if (!momentum[q].empty()) extraMomentum_[q] = ctx_.add(momentum[q]);
+      if (!position[q].empty()) extraPosition_[q] = ctx_.add(position[q]);
+      if (!dissipation[q].empty()) extraDissipation_[q] = ctx_.add(dissipation[q]);
+    }
+    out_.templateRows = std::move(t.rows);
+  }
+
+  static size_t linear(const std::vector<int>& shape, std::span<const long> point) {
+    size_t k = 0;
+    for (size_t d = 0; d < shape.size(); ++d) k = k * shape[d] + static_cast<size_t>(point[d] - 1);
+    return k;
+  }
+
+  Expr plus(Expr a, Expr extra) { return extra ? ctx_.add(a, extra) : a; }
+
   void derive(int q) {
     const flat::Variable& coord = m_.variables[q];
     int v = coord.derivative;
-    Expr p = partial(lagrangian_, v);
-    std::vector<Expr> parts{timeDerivative(p), ctx_.neg(partial(lagrangian_, q)), partial(dissipation_, v)};
+    if (templated_ && templateOf_[q] >= 0) {
+      out_.rows.push_back({q, nullptr, nullptr, true, templateOf_[q]});
+      return;
+    }
+    bool extra = templated_ && (extraMomentum_[q] || extraPosition_[q] || extraDissipation_[q]);
+    Expr p = templated_ ? plus(partial(lagrangian_, v), extraMomentum_[q]) : partial(lagrangian_, v);
+    std::vector<Expr> parts{timeDerivative(p), ctx_.neg(templated_ ? plus(partial(lagrangian_, q), extraPosition_[q]) : partial(lagrangian_, q)),
+                            templated_ ? plus(partial(dissipation_, v), extraDissipation_[q]) : partial(dissipation_, v)};
     for (Expr f : forces_[q]) parts.push_back(ctx_.neg(f));
     bool constrained = false;
     for (const auto& mult : out_.multipliers) {
@@ -203,13 +302,13 @@ class Deriver {
       parts.push_back(ctx_.neg(ctx_.mul(mult.symbol, dg)));
     }
     Expr residual = ctx_.add(parts);
-    if (lagrangian_.termsOf(q).empty() && lagrangian_.termsOf(v).empty() && forces_[q].empty() && !constrained) {
+    if (lagrangian_.termsOf(q).empty() && lagrangian_.termsOf(v).empty() && forces_[q].empty() && !constrained && !extra) {
       diags_.error(coord.declRange, DiagCode::E0401,
                    "coordinate '" + std::string(coord.name) + "' appears in no energy, force or constraint",
                    "add its kinetic energy in the mechanics section, or declare it as a plain 'Real'");
       return;
     }
-    bool inertial = !lagrangian_.termsOf(v).empty();
+    bool inertial = !lagrangian_.termsOf(v).empty() || (extra && extraMomentum_[q]);
     out_.rows.push_back({q, simplified(residual), simplified(p), inertial});
   }
 
@@ -220,8 +319,10 @@ class Deriver {
     bool conservative = m_.dissipation.empty() && !statedForces && m_.connectionsConserveEnergy &&
                         !lagrangian_.dependsOnTime;
     for (const auto& c : m_.constraints) conservative &= !ctx_.dependsOn(c.residual, m_.time());
+    conservative &= !templated_;  // Σ v ∂L/∂v over every element: a reduction the kernels do not loop yet
     std::vector<Expr> jacobi;  // Σ v ∂L/∂v, only built when the Jacobi integral exists
     for (const auto& row : out_.rows) {
+      if (row.templateRow >= 0) continue;
       const flat::Variable& coord = m_.variables[row.coordinate];
       int v = coord.derivative;
       if (conservative) jacobi.push_back(ctx_.mul(m_.variables[v].symbol, row.momentum));

@@ -16,6 +16,7 @@
 #include "flatten/FlatModel.h"
 #include "support/Diagnostic.h"
 #include "symbolic/Expr.h"
+#include "mechanics/TemplateRows.h"
 #include "symbolic/Simplify.h"
 
 namespace qdot::mech {
@@ -28,6 +29,9 @@ struct CoordinateRow {
   /// False when T does not contain der(q) (no inertia): the row then determines der(q) (if D or a
   /// force contains it: a first-order coordinate) or q itself (a massless node, spec §7).
   bool inertial = true;
+  /// ≥ 0: the row is EquationsOfMotion::templateRows[templateRow] at this coordinate's element
+  /// (residual and momentum are then null: the template stands for them).
+  int templateRow = -1;
 };
 
 struct Multiplier {
@@ -46,12 +50,17 @@ struct FirstIntegral {
 
 struct EquationsOfMotion {
   std::vector<CoordinateRow> rows;  ///< one per coordinate, in declaration order
+  /// Rows of coordinate arrays derived once per region (issue 15, TemplateRows.h): only when the
+  /// flat model keeps IndexedSums. Their coordinates' rows point here.
+  std::vector<TemplateRow> templateRows;
   std::vector<Multiplier> multipliers;
   std::vector<FirstIntegral> integrals;
   sym::Expr kinetic = nullptr, potential = nullptr, dissipation = nullptr;  ///< totals T, V, D
 };
 
-/// Derives the rows; reports located errors (E04xx) and returns nullopt on failure. At `simplify`
+/// Derives the rows; with IndexedSums in the model (flattened with FlattenLimits::keepLoops), the
+/// rows of coordinate arrays per region as templates and the peeled elements' rows as scalars, and
+/// no Jacobi integral (it would be a sum over every element). Reports located errors (E04xx) and returns nullopt on failure. At `simplify`
 /// (sym/Simplify.h) the energies are simplified before they are differentiated (so cyclic
 /// coordinates and time-independence are judged on the simplified Lagrangian), and the rows, the
 /// momenta and the first integrals after.

@@ -1,0 +1,352 @@
+// Repeated structure kept as templates (issue 15, docs/loops.md). With FlattenLimits::keepLoops,
+// a summand `sum(body for i in a:b, j in c:d)` of an energy statement whose body indexes declared
+// arrays by an iterator plus a constant (x[i+1], der(x[i]), k[i], y[i, j-1]) is lowered once, with
+// each such subscript a *relative symbol* (`x[%1+1]`), instead of once per element. Anything else
+// is lowered as before, so a template is only ever an exact rewriting of what expansion gives
+// (expandIndexedSums turns it back; tests/unit/IndexedSumTest.cpp checks node identity).
+#include <algorithm>
+#include <cmath>
+
+#include "flatten/Flattener.h"
+
+namespace qdot::flat {
+
+using namespace qdot::ast;
+using sym::Expr;
+
+namespace {
+
+/// Thrown by the template lowering where the scalar lowering must take over; never after a
+/// diagnostic was reported.
+struct NotATemplate {};
+
+bool mentions(const ast::Expr* e, const std::vector<TemplateIterator>& its);
+
+}  // namespace
+
+/// Decides from the syntax alone whether a sum's body can be lowered as a template: arithmetic,
+/// der() and elementary functions over numbers, names and subscripts, with the iterators only in
+/// subscripts of declared arrays as `i`, `i + e`, `e + i` or `i - e` (e free of iterators).
+/// Checking first means the template lowering never meets an iterator where a number is needed.
+class TemplateCheck {
+ public:
+  explicit TemplateCheck(const std::vector<TemplateIterator>& its) : its_(its) {}
+
+  bool body(const ast::Expr& e) const {
+    switch (e.kind) {
+      case ExprKind::Number: return true;
+      case ExprKind::Name: return !isIterator(*cast<NameExpr>(&e));
+      case ExprKind::Unary: return cast<UnaryExpr>(&e)->op != UnaryOp::Not && body(*cast<UnaryExpr>(&e)->operand);
+      case ExprKind::Binary: {
+        auto* b = cast<BinaryExpr>(&e);
+        bool arithmetic = b->op == BinaryOp::Add || b->op == BinaryOp::Sub || b->op == BinaryOp::Mul ||
+                          b->op == BinaryOp::Div || b->op == BinaryOp::Pow;
+        return arithmetic && body(*b->lhs) && body(*b->rhs);
+      }
+      case ExprKind::Call: return call(*cast<CallExpr>(&e));
+      case ExprKind::Index: return index(*cast<IndexExpr>(&e));
+      default: return false;
+    }
+  }
+
+  /// The iterator a subscript uses and the constant part's expression (nullptr: none), or -1.
+  int subscriptIterator(const ast::Expr& s, const ast::Expr*& offset, bool& negative) const {
+    offset = nullptr;
+    negative = false;
+    if (auto* n = dyn_cast<NameExpr>(&s)) return iteratorIndex(*n);
+    auto* b = dyn_cast<BinaryExpr>(&s);
+    if (!b || (b->op != BinaryOp::Add && b->op != BinaryOp::Sub)) return -1;
+    auto* l = dyn_cast<NameExpr>(b->lhs.get());
+    if (int k = l ? iteratorIndex(*l) : -1; k >= 0 && !mentions(b->rhs.get(), its_)) {
+      offset = b->rhs.get();
+      negative = b->op == BinaryOp::Sub;
+      return k;
+    }
+    auto* r = dyn_cast<NameExpr>(b->rhs.get());
+    if (int k = r ? iteratorIndex(*r) : -1; k >= 0 && b->op == BinaryOp::Add && !mentions(b->lhs.get(), its_)) {
+      offset = b->lhs.get();
+      return k;
+    }
+    return -1;
+  }
+
+  int iteratorIndex(const NameExpr& n) const {
+    if (n.parts.size() != 1) return -1;
+    for (size_t k = 0; k < its_.size(); ++k)
+      if (its_[k].name == n.parts[0]) return static_cast<int>(k);
+    return -1;
+  }
+
+ private:
+  const std::vector<TemplateIterator>& its_;
+
+  bool isIterator(const NameExpr& n) const { return iteratorIndex(n) >= 0; }
+
+  bool call(const CallExpr& c) const {
+    static const char* const kAllowed[] = {"der", "sin", "cos", "tan", "asin", "acos", "atan", "sinh", "cosh",
+                                           "tanh", "exp", "log", "sqrt", "abs"};
+    std::string name = c.callee->dotted();
+    bool allowed = std::any_of(std::begin(kAllowed), std::end(kAllowed), [&](const char* a) { return name == a; });
+    if (!allowed || c.args.size() != 1 || !c.namedArgs.empty()) return false;
+    return body(*c.args[0]);
+  }
+
+  bool index(const IndexExpr& e) const {
+    auto* base = dyn_cast<NameExpr>(e.base.get());
+    if (!base || base->parts.size() != 1 || isIterator(*base)) return false;
+    for (const auto& s : e.subscripts) {
+      if (!mentions(s.get(), its_)) continue;
+      const ast::Expr* offset;
+      bool negative;
+      if (subscriptIterator(*s, offset, negative) < 0) return false;
+    }
+    return true;
+  }
+};
+
+namespace {
+
+// True if the expression names one of the iterators anywhere.
+bool mentions(const ast::Expr* e, const std::vector<TemplateIterator>& its) {
+  if (!e) return false;
+  switch (e->kind) {
+    case ExprKind::Name: return TemplateCheck(its).iteratorIndex(*cast<NameExpr>(e)) >= 0;
+    case ExprKind::Unary: return mentions(cast<UnaryExpr>(e)->operand.get(), its);
+    case ExprKind::Binary:
+      return mentions(cast<BinaryExpr>(e)->lhs.get(), its) || mentions(cast<BinaryExpr>(e)->rhs.get(), its);
+    case ExprKind::Call: {
+      auto* c = cast<CallExpr>(e);
+      return std::any_of(c->args.begin(), c->args.end(), [&](const ExprPtr& a) { return mentions(a.get(), its); });
+    }
+    case ExprKind::Index: {
+      auto* x = cast<IndexExpr>(e);
+      return mentions(x->base.get(), its) ||
+             std::any_of(x->subscripts.begin(), x->subscripts.end(), [&](const ExprPtr& s) { return mentions(s.get(), its); });
+    }
+    case ExprKind::Number:
+    case ExprKind::Bool:
+    case ExprKind::String:
+    case ExprKind::End: return false;
+    default: return true;  // anything else: assume it may (the check then refuses the template)
+  }
+}
+
+// The top-level summands of an energy statement, with their signs.
+void collectSummands(const ast::Expr& e, bool negated, std::vector<Summand>& out) {
+  if (auto* b = dyn_cast<BinaryExpr>(&e); b && (b->op == BinaryOp::Add || b->op == BinaryOp::Sub)) {
+    collectSummands(*b->lhs, negated, out);
+    collectSummands(*b->rhs, b->op == BinaryOp::Sub ? !negated : negated, out);
+    return;
+  }
+  if (auto* u = dyn_cast<UnaryExpr>(&e); u && u->op != UnaryOp::Not) {
+    collectSummands(*u->operand, u->op == UnaryOp::Neg ? !negated : negated, out);
+    return;
+  }
+  out.push_back({&e, negated});
+}
+
+const CallExpr* sumCall(const ast::Expr& e) {
+  auto* c = dyn_cast<CallExpr>(&e);
+  if (!c || c->callee->dotted() != "sum" || c->args.size() != 1 || !c->namedArgs.empty()) return nullptr;
+  return dyn_cast<ComprehensionExpr>(c->args[0].get()) ? c : nullptr;
+}
+
+}  // namespace
+
+void Flattener::addTermsKeepingLoops(std::vector<Term>& into, const MechanicsStmt& st, const char* what) {
+  std::vector<Summand> summands;
+  collectSummands(*st.value, false, summands);
+  std::vector<Expr> scalars;
+  std::vector<IndexedSum> sums;
+  for (const Summand& s : summands) {
+    if (const CallExpr* c = sumCall(*s.expr); c && !m_.calls.count(c)) {
+      IndexedSum sum;
+      if (lowerIndexedSum(*c, s.negated, sum)) {
+        sums.push_back(std::move(sum));
+        continue;
+      }
+    }
+    Expr v = lowerScalar(*s.expr, what);
+    scalars.push_back(s.negated ? ctx_.neg(v) : v);
+  }
+  IndexedSum::Energy energy = st.kind == MechanicsKind::Kinetic     ? IndexedSum::Energy::Kinetic
+                              : st.kind == MechanicsKind::Potential ? IndexedSum::Energy::Potential
+                                                                    : IndexedSum::Energy::Dissipation;
+  for (IndexedSum& sum : sums) {
+    sum.energy = energy;
+    sum.term = static_cast<int>(into.size());
+    out_.indexedSums.push_back(std::move(sum));
+  }
+  into.push_back({ctx_.add(scalars), st.range});
+}
+
+// Lowers the sum as a template; false (nothing reported, nothing recorded) where the scalar
+// lowering must do it.
+bool Flattener::lowerIndexedSum(const CallExpr& call, bool negated, IndexedSum& sum) {
+  const auto& comp = *cast<ComprehensionExpr>(call.args[0].get());
+  std::vector<TemplateIterator> its;
+  for (const auto& it : comp.iterators) {
+    auto* r = dyn_cast<RangeExpr>(it.range.get());
+    if (!r || !r->start || !r->stop || r->step) return false;
+    if (mentions(r->start.get(), its) || mentions(r->stop.get(), its)) return false;
+    // Bounds that are not plain integers (1:1e300, 1:2.5) are the scalar lowering's to report.
+    Expr lo = lowerScalar(*r->start, "a loop range"), hi = lowerScalar(*r->stop, "a loop range");
+    auto plain = [](Expr v) { return v->isConstant() && std::abs(v->value) < 1e9 && v->value == std::floor(v->value); };
+    if (!plain(lo) || !plain(hi)) return false;
+    its.push_back({it.name, static_cast<long>(lo->value), static_cast<long>(hi->value)});
+    if (its.back().last < its.back().first) return false;  // an empty sum: 0, as the scalar lowering gives
+  }
+  if (!TemplateCheck(its).body(*comp.body)) return false;
+  templateIterators_ = std::move(its);
+  try {
+    sum.body = lowerScalar(*comp.body, "the terms of a sum");
+  } catch (NotATemplate&) {
+    templateIterators_.clear();
+    return false;
+  } catch (...) {
+    templateIterators_.clear();
+    throw;
+  }
+  if (negated) sum.body = ctx_.neg(sum.body);
+  for (const auto& it : templateIterators_) sum.box.push_back({it.first, it.last});
+  sum.range = call.range;
+  templateIterators_.clear();
+  return true;
+}
+
+// x[i+1] inside a template: the relative symbol of that pattern (nullopt: no iterator in the
+// subscripts, an ordinary subscript).
+std::optional<Value> Flattener::lowerRelativeIndex(const IndexExpr& e) {
+  if (!mentions(&e, templateIterators_)) return std::nullopt;
+  Value holder;
+  const Value& base = subscriptBase(*e.base, holder);
+  if (&base == &holder || e.subscripts.size() != base.shape.size()) throw NotATemplate{};
+  RelativeElement rel;
+  TemplateCheck check(templateIterators_);
+  for (size_t d = 0; d < e.subscripts.size(); ++d) {
+    const ast::Expr* offsetExpr;
+    bool negative;
+    int k = check.subscriptIterator(*e.subscripts[d], offsetExpr, negative);
+    long offset = 0;
+    if (k < 0) {
+      offset = plainInteger(*e.subscripts[d]);
+    } else if (offsetExpr) {
+      offset = plainInteger(*offsetExpr);
+      if (negative) offset = -offset;
+    }
+    long lo = k < 0 ? offset : templateIterators_[k].first + offset;
+    long hi = k < 0 ? offset : templateIterators_[k].last + offset;
+    if (lo < 1 || hi > base.shape[d]) throw NotATemplate{};  // the scalar lowering reports it
+    rel.dims.push_back({k, static_cast<int>(offset)});
+  }
+  rel.array = arrayOf(base, cast<NameExpr>(e.base.get())->parts[0]);
+  return Value::scalar(relativeSymbol(rel));
+}
+
+// A subscript's constant part as an integer; anything else (a range, `end`, 1.5) is the scalar
+// lowering's to take (and to report).
+long Flattener::plainInteger(const ast::Expr& e) {
+  if (e.kind == ExprKind::Range || e.kind == ExprKind::End || e.kind == ExprKind::Comprehension) throw NotATemplate{};
+  Expr v = lowerScalar(e, "a subscript");
+  if (!v->isConstant() || std::abs(v->value) >= 1e9 || v->value != std::floor(v->value)) throw NotATemplate{};
+  return static_cast<long>(v->value);
+}
+
+int Flattener::arrayOf(const Value& declared, const std::string& name) {
+  auto [it, added] = arrayIds_.try_emplace(&declared, static_cast<int>(out_.patterns->arrays.size()));
+  if (!added) return it->second;
+  std::string unique = name;
+  auto taken = [&](const std::string& n) {
+    return std::any_of(out_.patterns->arrays.begin(), out_.patterns->arrays.end(), [&](const ArrayVariable& a) { return a.name == n; });
+  };
+  for (int k = 2; taken(unique); ++k) unique = name + "#" + std::to_string(k);
+  out_.patterns->arrays.push_back({unique, declared.shape, std::vector<Expr>(declared.elems.begin(), declared.elems.end())});
+  return it->second;
+}
+
+Expr Flattener::relativeSymbol(const RelativeElement& rel) { return out_.patterns->symbol(ctx_, rel); }
+
+// der(x[%1+1]) = der(x)[%1+1]: the array of the elements' derivatives, made once. Only arrays of
+// coordinates and velocities (whose derivatives every element has in the scalar lowering too) and
+// of parameters and constants (derivative 0).
+Expr Flattener::rateOfRelative(const RelativeElement& rel) {
+  ArrayVariable& a = out_.patterns->arrays[rel.array];
+  if (a.derivative < 0) {
+    std::vector<Expr> rates;
+    bool constant = true, moving = true;
+    for (Expr e : a.elements) {
+      int var = out_.variableOf(e);
+      VarRole role = var >= 0 ? out_.variables[var].role : VarRole::Parameter;
+      bool isConstant = e->isConstant() || (var >= 0 && role == VarRole::Parameter);
+      bool isMoving = var >= 0 && (role == VarRole::Coordinate || role == VarRole::Velocity);
+      constant &= isConstant;
+      moving &= isMoving;
+    }
+    if (constant) return ctx_.zero();
+    if (!moving) throw NotATemplate{};
+    for (Expr e : a.elements) rates.push_back(out_.variables[derivativeVariable(out_.variableOf(e), derivativeSite_)].symbol);
+    int id = static_cast<int>(out_.patterns->arrays.size());
+    out_.patterns->arrays.push_back({"der(" + a.name + ")", a.shape, std::move(rates)});
+    out_.patterns->arrays[rel.array].derivative = id;
+  }
+  RelativeElement d = rel;
+  d.array = out_.patterns->arrays[rel.array].derivative;
+  return relativeSymbol(d);
+}
+
+Expr ElementPatterns::symbol(sym::Context& ctx, const RelativeElement& rel) {
+  std::string name = arrays[rel.array].name + "[";
+  for (size_t d = 0; d < rel.dims.size(); ++d) {
+    if (d) name += ",";
+    const auto& dim = rel.dims[d];
+    if (dim.iterator < 0) {
+      name += std::to_string(dim.offset);
+      continue;
+    }
+    name += "%" + std::to_string(dim.iterator + 1);
+    if (dim.offset) name += (dim.offset > 0 ? "+" : "") + std::to_string(dim.offset);
+  }
+  Expr s = ctx.symbol(name + "]");
+  elements_.try_emplace(s->symbolId, rel);
+  return s;
+}
+
+Expr ElementPatterns::elementAt(const RelativeElement& rel, std::span<const long> point) const {
+  const ArrayVariable& a = arrays[rel.array];
+  size_t flat = 0;
+  for (size_t d = 0; d < rel.dims.size(); ++d) {
+    long sub = rel.dims[d].offset + (rel.dims[d].iterator < 0 ? 0 : point[rel.dims[d].iterator]);
+    flat = flat * a.shape[d] + static_cast<size_t>(sub - 1);
+  }
+  return a.elements[flat];
+}
+
+Expr instantiate(const FlatModel& model, sym::Context& ctx, Expr body, std::span<const long> point) {
+  std::unordered_map<Expr, Expr> map;
+  for (Expr s : ctx.freeSymbols(body))
+    if (const RelativeElement* rel = model.relativeElement(s)) map.emplace(s, model.patterns->elementAt(*rel, point));
+  return ctx.substitute(body, map);
+}
+
+void expandIndexedSums(FlatModel& model, sym::Context& ctx) {
+  for (const IndexedSum& sum : model.indexedSums) {
+    std::vector<Expr> parts;
+    parts.reserve(sum.pointCount());
+    std::vector<long> point;
+    for (auto [lo, hi] : sum.box) point.push_back(lo);
+    for (size_t n = sum.pointCount(); n > 0; --n) {
+      parts.push_back(instantiate(model, ctx, sum.body, point));
+      for (size_t d = point.size(); d-- > 0;) {  // row-major: the last iterator fastest
+        if (++point[d] <= sum.box[d].second) break;
+        point[d] = sum.box[d].first;
+      }
+    }
+    std::vector<Term>& terms = sum.energy == IndexedSum::Energy::Kinetic     ? model.kinetic
+                               : sum.energy == IndexedSum::Energy::Potential ? model.potential
+                                                                             : model.dissipation;
+    terms[sum.term].value = ctx.add(terms[sum.term].value, ctx.add(parts));
+  }
+  model.indexedSums.clear();
+}
+
+}  // namespace qdot::flat

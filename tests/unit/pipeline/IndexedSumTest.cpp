@@ -1,0 +1,232 @@
+// Repeated structure kept as templates (flatten/IndexedSums.cpp, issue 15): a sum kept as an
+// IndexedSum and expanded again must give exactly the energy terms the scalar lowering gives (the
+// same hash-consed nodes), and only sums whose bodies index arrays by iterator + constant are kept.
+#include <gtest/gtest.h>
+
+#include "unit/common/SourceDae.h"
+#include <algorithm>
+#include <cmath>
+
+#include "flatten/Flatten.h"
+#include "mechanics/EulerLagrange.h"
+#include "mechanics/TemplateRows.h"
+
+namespace qdot {
+namespace {
+
+struct Flattened {
+  std::optional<flat::FlatModel> scalar, templated;
+};
+
+// Both flattenings of one checked model, in one Context (so equal terms are the same node).
+Flattened flattenBoth(test::SourceDae& s) {
+  Flattened f;
+  f.scalar = flat::flatten(*s.compilation.checked, s.ctx, s.diags, {});
+  flat::FlattenLimits keep;
+  keep.keepLoops = true;
+  f.templated = flat::flatten(*s.compilation.checked, s.ctx, s.diags, keep);
+  return f;
+}
+
+void expectSameTerms(const std::vector<flat::Term>& a, const std::vector<flat::Term>& b, const char* what) {
+  ASSERT_EQ(a.size(), b.size()) << what;
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i].value, b[i].value) << what << " term " << i;
+}
+
+// Expands the templates and checks the model is the scalar one: energies node for node, variables
+// in the same order.
+void expectExpandsToScalar(test::SourceDae& s, Flattened& f) {
+  ASSERT_TRUE(f.scalar && f.templated);
+  flat::expandIndexedSums(*f.templated, s.ctx);
+  expectSameTerms(f.scalar->kinetic, f.templated->kinetic, "kinetic");
+  expectSameTerms(f.scalar->potential, f.templated->potential, "potential");
+  expectSameTerms(f.scalar->dissipation, f.templated->dissipation, "dissipation");
+  ASSERT_EQ(f.scalar->variables.size(), f.templated->variables.size());
+  for (size_t i = 0; i < f.scalar->variables.size(); ++i)
+    EXPECT_EQ(f.scalar->variables[i].symbol, f.templated->variables[i].symbol) << "variable " << i;
+}
+
+constexpr const char* kChain = R"(model Chain
+  parameter Integer n = 6;
+  parameter Real m = 1, k = 1000, c = 0.5;
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+mechanics
+  kinetic = sum(0.5*m*der(x[i])^2 for i in 1:n);
+  potential = 0.5*k*x[1]^2 + sum(0.5*k*(x[i+1] - x[i])^2 for i in 1:n-1);
+  dissipation = 0.5*c*der(x[1])^2 + sum(0.5*c*(der(x[i+1]) - der(x[i]))^2 for i in 1:n-1);
+end Chain;
+)";
+
+TEST(IndexedSum, ChainKeepsEverySumAndExpandsToTheScalarTerms) {
+  test::SourceDae s("chain.qd", kChain, driver::Stage::Check);
+  Flattened f = flattenBoth(s);
+  ASSERT_TRUE(f.templated);
+  ASSERT_EQ(f.templated->indexedSums.size(), 3u);
+  EXPECT_EQ(f.templated->indexedSums[1].box, (std::vector<std::pair<long, long>>{{1, 5}}));
+  // x and der(x): the arrays the relative symbols index
+  ASSERT_EQ(f.templated->patterns->arrays.size(), 2u);
+  EXPECT_EQ(f.templated->patterns->arrays[1].name, "der(x)");
+  sym::Expr next = s.ctx.findSymbol("x[%1+1]");
+  ASSERT_NE(next, nullptr);
+  const flat::RelativeElement* rel = f.templated->relativeElement(next);
+  ASSERT_NE(rel, nullptr);
+  EXPECT_EQ(rel->dims[0].iterator, 0);
+  EXPECT_EQ(rel->dims[0].offset, 1);
+  expectExpandsToScalar(s, f);
+}
+
+TEST(IndexedSum, GridOfMassesKeepsTwoIterators) {
+  test::SourceDae s("grid.qd", R"(model Grid
+  parameter Integer n = 4, m = 3;
+  parameter Real k = 10, mass[n, m] = fill(2, n, m);
+  coordinate Real z[n, m](each start = 0.1);
+mechanics
+  kinetic = sum(0.5*mass[i, j]*der(z[i, j])^2 for i in 1:n, j in 1:m);
+  potential = sum(0.5*k*(z[i+1, j] - z[i, j])^2 for i in 1:n-1, j in 1:m)
+            + sum(0.5*k*(z[i, j+1] - z[i, j])^2 for i in 1:n, j in 1:m-1)
+            + sum(0.5*k*z[1, j]^2 for j in 1:m) - sum(-0.5*k*z[n, j]^2 for j in 1:m);
+end Grid;
+)", driver::Stage::Check);
+  Flattened f = flattenBoth(s);
+  ASSERT_TRUE(f.templated);
+  EXPECT_EQ(f.templated->indexedSums.size(), 5u);
+  EXPECT_NE(s.ctx.findSymbol("z[%1,%2+1]"), nullptr);
+  EXPECT_NE(s.ctx.findSymbol("z[1,%1]"), nullptr);
+  expectExpandsToScalar(s, f);
+}
+
+TEST(IndexedSum, BodiesThatAreNotAffineInTheIteratorStayScalar) {
+  test::SourceDae s("other.qd", R"(model Other
+  parameter Integer n = 4;
+  coordinate Real x[2*n];
+mechanics
+  kinetic = sum(0.5*der(x[2*i])^2 + 0.5*der(x[2*i-1])^2 for i in 1:n);
+  potential = sum(i*x[i]^2 for i in 1:n) + sum(x[j]^2 for j in {1, 3, 5}) + sum(if j > 2 then x[j]^4 else 0 for j in 1:2*n);
+end Other;
+)", driver::Stage::Check);
+  Flattened f = flattenBoth(s);
+  ASSERT_TRUE(f.templated);
+  EXPECT_TRUE(f.templated->indexedSums.empty());
+  expectExpandsToScalar(s, f);
+}
+
+}  // namespace
+}  // namespace qdot
+
+namespace qdot {
+namespace {
+
+// Coordinates that occur outside the templates (scalar energy terms, forces): their rows are peeled.
+std::vector<char> peeledCoordinates(const flat::FlatModel& m, sym::Context& ctx) {
+  std::vector<char> peeled(m.variables.size(), 0);
+  auto mark = [&](sym::Expr e) {
+    for (sym::Expr s : ctx.freeSymbols(e)) {
+      int var = m.variableOf(s);
+      if (var < 0) continue;
+      if (m.variables[var].role == flat::VarRole::Velocity) var = m.variables[var].derivativeOf;
+      peeled[var] = 1;
+    }
+  };
+  for (const auto* terms : {&m.kinetic, &m.potential, &m.dissipation})
+    for (const auto& t : *terms) mark(t.value);
+  for (const auto& f : m.forces) peeled[f.first] = 1;
+  return peeled;
+}
+
+// Each template row, instantiated at every point of its region, equals the scalar derivation's row
+// of that element (evaluated at the same random values of every symbol: both are polynomials or
+// smooth functions of them, so equal values at random points are equal rows for all practical
+// purposes; a wrong offset or sign changes the value). Returns the rows for further checks.
+std::vector<mech::TemplateRow> expectRowsMatchScalarDerivation(const char* name, const char* text) {
+  test::SourceDae s(name, text, driver::Stage::Check);
+  Flattened f = flattenBoth(s);
+  EXPECT_TRUE(f.scalar && f.templated);
+  if (!f.scalar || !f.templated) return {};
+  auto eom = mech::deriveEquationsOfMotion(*f.scalar, s.ctx, s.diags);
+  EXPECT_TRUE(eom);
+  if (!eom) return {};
+  mech::TemplateDerivation t =
+      mech::deriveTemplateRows(*f.templated, s.ctx, peeledCoordinates(*f.templated, s.ctx), sym::SimplifyLevel::Fast);
+  EXPECT_TRUE(t.scalarSums.empty());
+  std::vector<double> values(s.ctx.symbolCount() + 1000);
+  for (size_t i = 0; i < values.size(); ++i) values[i] = 0.3 + 0.7 * std::sin(1.0 + 1.7 * static_cast<double>(i));
+  for (const mech::TemplateRow& row : t.rows) {
+    const flat::ArrayVariable& a = f.templated->patterns->arrays[row.array];
+    std::vector<long> point;
+    for (auto [lo, hi] : row.region) point.push_back(lo);
+    for (size_t n = row.pointCount(); n > 0; --n) {
+      size_t flatIndex = 0;
+      for (size_t d = 0; d < point.size(); ++d) flatIndex = flatIndex * a.shape[d] + (point[d] - 1);
+      sym::Expr coordinate = a.elements[flatIndex];
+      const mech::CoordinateRow* scalar = nullptr;
+      for (const auto& r : eom->rows)
+        if (f.scalar->variables[r.coordinate].symbol == coordinate) scalar = &r;
+      EXPECT_NE(scalar, nullptr);
+      if (scalar) {
+        values.resize(std::max(values.size(), s.ctx.symbolCount()), 0.5);
+        sym::Expr instance = flat::instantiate(*f.templated, s.ctx, row.residual, point);
+        values.resize(std::max(values.size(), s.ctx.symbolCount()), 0.5);
+        double expected = sym::evaluate(scalar->residual, values), got = sym::evaluate(instance, values);
+        EXPECT_NEAR(got, expected, 1e-12 * (1 + std::abs(expected))) << s.ctx.symbolName(coordinate);
+      }
+      for (size_t d = point.size(); d-- > 0;) {
+        if (++point[d] <= row.region[d].second) break;
+        point[d] = row.region[d].first;
+      }
+    }
+  }
+  // The whole derivation with templates: template rows where the regions are, the scalar rows of
+  // the peeled elements (with the templates' contributions instantiated), each equal to the scalar one.
+  auto templated = mech::deriveEquationsOfMotion(*f.templated, s.ctx, s.diags);
+  EXPECT_TRUE(templated);
+  if (!templated) return t.rows;
+  EXPECT_EQ(templated->rows.size(), eom->rows.size());
+  EXPECT_EQ(templated->templateRows.size(), t.rows.size());
+  size_t viaTemplates = 0;
+  for (size_t r = 0; r < std::min(templated->rows.size(), eom->rows.size()); ++r) {
+    const auto& row = templated->rows[r];
+    EXPECT_EQ(f.templated->variables[row.coordinate].symbol, f.scalar->variables[eom->rows[r].coordinate].symbol);
+    sym::Expr value = row.residual;
+    if (row.templateRow >= 0) {
+      ++viaTemplates;
+      const mech::TemplateRow& tr = templated->templateRows[row.templateRow];
+      const flat::ArrayVariable& a = f.templated->patterns->arrays[tr.array];
+      size_t k = std::find(a.elements.begin(), a.elements.end(), f.templated->variables[row.coordinate].symbol) - a.elements.begin();
+      std::vector<long> point(a.shape.size());
+      for (size_t d = a.shape.size(); d-- > 0;) point[d] = static_cast<long>(k % a.shape[d]) + 1, k /= a.shape[d];
+      value = flat::instantiate(*f.templated, s.ctx, tr.residual, point);
+    }
+    values.resize(std::max(values.size(), s.ctx.symbolCount()), 0.5);
+    double expected = sym::evaluate(eom->rows[r].residual, values), got = sym::evaluate(value, values);
+    EXPECT_NEAR(got, expected, 1e-12 * (1 + std::abs(expected))) << "row " << r;
+  }
+  EXPECT_GT(viaTemplates, 0u);
+  return t.rows;
+}
+
+TEST(TemplateRows, ChainInteriorIsOneTemplateAndEqualsTheScalarRows) {
+  std::string chain = kChain;
+  auto rows = expectRowsMatchScalarDerivation("chain.qd", chain.c_str());
+  ASSERT_EQ(rows.size(), 1u);  // x[1] and x[n] peeled (the wall spring, the free end)
+  EXPECT_EQ(rows[0].region, (std::vector<std::pair<long, long>>{{2, 5}}));
+}
+
+TEST(TemplateRows, GridOfMassesHasItsInteriorAndEdgesAsTemplates) {
+  auto rows = expectRowsMatchScalarDerivation("grid.qd", R"(model Grid
+  parameter Integer n = 6, m = 5;
+  parameter Real k = 10, c = 0.1, mass[n, m] = fill(2, n, m);
+  coordinate Real z[n, m](each start = 0.1);
+mechanics
+  kinetic = sum(0.5*mass[i, j]*der(z[i, j])^2 for i in 1:n, j in 1:m);
+  potential = sum(0.5*k*(z[i+1, j] - z[i, j])^2 for i in 1:n-1, j in 1:m)
+            + sum(0.5*k*(z[i, j+1] - z[i, j])^2 + 0.1*k*z[i, j]^4 for i in 1:n, j in 1:m-1);
+  dissipation = sum(0.5*c*(der(z[i+1, j]) - der(z[i, j]))^2 for i in 1:n-1, j in 1:m);
+end Grid;
+)");
+  // dimension 1 splits into {1}, 2..5, {6}; dimension 2 into {1}, 2..4, {5}: the 9 regions less the
+  // 4 corners (one element each)
+  EXPECT_EQ(rows.size(), 5u);
+}
+
+}  // namespace
+}  // namespace qdot
