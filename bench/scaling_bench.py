@@ -1,0 +1,101 @@
+#!/usr/bin/env python3
+"""Scaling of the whole pipeline on the spring-damper chain, n = 10^3 ... 10^6 (issue 15 §3).
+
+    bench/scaling_bench.py --build DIR [--quick] [--sizes 1000,10000,...]
+
+For each n, one fresh process each (peak memory by wait4's ru_maxrss):
+  * qdot run examples/vibration/spring_chain.qd -p n=N --jit-wait  (compile every stage, the JIT,
+    then IDA) with a horizon of 1e-4 s: what is measured is the way from the file to the first steps;
+    the compile stages' times come from --stats;
+  * the hand-written C++ program on the same IDA and KLU (build/bench/reference_sim chain), same
+    horizon, same tolerances.
+Prints a markdown table (time per stage, file to first step, peak memory, both programs side by
+side) and the fitted exponent of each column between consecutive sizes (t ~ n^k).
+"""
+import argparse
+import math
+import os
+import re
+import subprocess
+import sys
+import time
+
+CHAIN = "examples/vibration/spring_chain.qd"
+STAGES = ["flatten", "derive", "dae", "kernel"]
+
+
+def peak_of(command):
+    # ru_maxrss of RUSAGE_CHILDREN is the largest child so far: measure each run in its own
+    # Python child so earlier (bigger) runs do not hide it.
+    code = ("import resource,subprocess,sys,time;t=time.perf_counter();"
+            "p=subprocess.run(sys.argv[1:],stdout=subprocess.DEVNULL,stderr=subprocess.PIPE,text=True);"
+            "w=time.perf_counter()-t;"
+            "print(w, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss/1024.0, p.returncode);"
+            "sys.stderr.write(p.stderr)")
+    p = subprocess.run([sys.executable, "-c", code] + command, capture_output=True, text=True)
+    wall, peak, rc = p.stdout.split()
+    if int(rc) != 0:
+        sys.exit(f"failed ({rc}): {' '.join(command)}\n{p.stderr}")
+    return float(wall), float(peak), p.stderr
+
+
+def number(pattern, text, default=float("nan")):
+    m = re.search(pattern, text)
+    return float(m.group(1)) if m else default
+
+
+def measure(build, n, stop):
+    qdot = [f"{build}/qdot", "run", CHAIN, "-p", f"n={n}", "--stop", str(stop), "--interval", str(stop),
+            "--outputs", "x[1]", "-o", "/dev/null", "--stats", "--jit-wait", "--no-progress"]
+    wall, peak, err = peak_of(qdot)
+    stages = {s: number(rf"{s} ([0-9.e+-]+)", err) / 1e3 for s in STAGES}
+    stages["codegen"] = number(r"codegen \([^)]*\) ([0-9.e+-]+)", err) / 1e3
+    setup = number(r"setup ([0-9.e+-]+) s", err)
+    solve = number(r"solve ([0-9.e+-]+) s", err)
+    hand = [f"{build}/bench/reference_sim", "chain", "--n", str(n), "--stop", str(stop), "--interval", str(stop),
+            "--outputs", "x[1]", "-o", "/dev/null", "--stats"]
+    hwall, hpeak, herr = peak_of(hand)
+    hsetup = number(r"setup ([0-9.e+-]+) s", herr)
+    return {"n": n, "wall": wall, "peak": peak, "setup": setup, "solve": solve, **stages,
+            "first": wall - solve, "hwall": hwall, "hpeak": hpeak, "hfirst": hwall - number(r"solve ([0-9.e+-]+) s", herr),
+            "hsetup": hsetup}
+
+
+def exponent(a, b, key):
+    if a[key] <= 0 or b[key] <= 0 or any(map(math.isnan, (a[key], b[key]))):
+        return float("nan")
+    return math.log(b[key] / a[key]) / math.log(b["n"] / a["n"])
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--build", default="build")
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--sizes", default=None)
+    ap.add_argument("--stop", type=float, default=1e-4)
+    a = ap.parse_args()
+    sizes = [int(s) for s in a.sizes.split(",")] if a.sizes else ([1000, 10000, 100000] if a.quick else
+                                                                   [1000, 10000, 100000, 1000000])
+    rows = [measure(a.build, n, a.stop) for n in sizes]
+    print("\n## Scaling: the spring chain from the file to the first steps (bench/scaling_bench.py)\n")
+    print(f"Horizon {a.stop:g} s (IDACalcIC and the first steps), rtol 1e-6, KLU; qdot with --jit-wait "
+          "(every stage, then native code). Times in seconds, memory = peak RSS.\n")
+    cols = ["flatten", "derive", "dae", "kernel", "codegen", "setup", "first", "peak", "hsetup", "hfirst", "hpeak"]
+    head = ["n", "flatten", "derive", "dae", "kernel", "codegen+JIT", "IDA setup", "**file → first step**",
+            "peak [MiB]", "hand setup", "**hand: start → first step**", "hand peak [MiB]", "time ratio", "memory ratio"]
+    print("| " + " | ".join(head) + " |")
+    print("|" + "---:|" * len(head))
+    for r in rows:
+        cells = [f"{r['n']:,}".replace(",", " ")] + [f"{r[c]:.3g}" for c in cols]
+        cells += [f"{r['first'] / r['hfirst']:.2f}", f"{r['peak'] / r['hpeak']:.2f}"]
+        print("| " + " | ".join(cells) + " |")
+    if len(rows) > 1:
+        print("\nFitted exponents k (t ~ n^k) between consecutive sizes:\n")
+        print("| from → to | " + " | ".join(cols) + " |")
+        print("|---|" + "---:|" * len(cols))
+        for x, y in zip(rows, rows[1:]):
+            print(f"| {x['n']} → {y['n']} | " + " | ".join(f"{exponent(x, y, c):.2f}" for c in cols) + " |")
+
+
+if __name__ == "__main__":
+    main()
