@@ -42,6 +42,7 @@ struct TieringRule {
   double nativeSpeedup = 4;  ///< VM / native time of a residual or Jacobian call (measured 5.7-17)
   double payback = 2;        ///< the projected saving must exceed this many compile CPU times
   double minObserved = 0.1;  ///< decide only once the VM calls took this fraction of the compile
+  double minProgress = 0.01;  ///< and the run got this far (past the solver's first, tiny steps)
 };
 
 struct TierVerdict {

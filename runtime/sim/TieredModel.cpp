@@ -1,5 +1,5 @@
 // Every residual and Jacobian call goes to the second tier once it has been published (one acquire
-// load per call), else to the first, timed; every other call goes to the first. The table (names,
+// load per call), else to the first, timed (a sample); every other call goes to the first. The table (names,
 // sizes, Jacobian pattern) is the first tier's: both tiers are built from the same kernels.
 // lastError asks whichever tier made the last call. The ABI hands out const pointers to the model,
 // but the tiered model is ours and mutable: its counters and the trigger live on the solver thread.
@@ -14,9 +14,11 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Residual calls on the first tier between two questions to the trigger: the question is a few
-// floating-point operations, a residual call at least a microsecond.
+// First-tier calls between two questions to the trigger (a few floating-point operations).
 constexpr uint64_t kAskEvery = 8;
+// One first-tier call in kTimeEvery is timed and counts kTimeEvery times: reading the clock twice
+// costs about as much as a call of the smallest models, which the solver may make millions of.
+constexpr uint64_t kTimeEvery = 4;
 
 double secondsBetween(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration<double>(to - from).count();
@@ -41,8 +43,9 @@ struct Tiered : QdotModel {
   bool started = false;
   uint64_t nextQuestion = kAskEvery;
   TierObservation look;  // what the trigger saw last (frozen once it started the compile)
-  // Where the recent window starts: `older` has a quarter to a half of the first-tier time so far.
-  TierObservation older, newer;
+  // The recent window starts at `windowStart`, a look at between a quarter and a half of the
+  // progress so far; `nextStart` takes its place once the progress has doubled since.
+  TierObservation windowStart, nextStart;
 
   TierObservation observe() const {
     TierObservation o;
@@ -50,16 +53,9 @@ struct Tiered : QdotModel {
     o.elapsedSeconds = secondsBetween(created, Clock::now());
     o.firstTierSeconds = firstSeconds;
     o.firstTierCalls = firstCalls;
-    o.recentProgress = o.progress - older.progress;
-    o.recentFirstTierSeconds = o.firstTierSeconds - older.firstTierSeconds;
+    o.recentProgress = o.progress - windowStart.progress;
+    o.recentFirstTierSeconds = o.firstTierSeconds - windowStart.firstTierSeconds;
     return o;
-  }
-
-  // Moves the recent window on once the first-tier time has doubled since its newer anchor.
-  void anchor(const TierObservation& now) {
-    if (now.firstTierSeconds < 2 * newer.firstTierSeconds) return;
-    older = newer;
-    newer = now;
   }
 
   void startCompile() {
@@ -81,8 +77,8 @@ struct Tiered : QdotModel {
     if (started || firstCalls < nextQuestion) return;
     nextQuestion = firstCalls + kAskEvery;
     look = observe();
-    if (trigger(look)) startCompile();
-    else anchor(look);
+    if (trigger(look)) return startCompile();
+    if (look.progress >= 2 * nextStart.progress) windowStart = nextStart, nextStart = look;
   }
 
   // A residual or Jacobian call: the second tier once published, else the first, timed.
@@ -94,10 +90,14 @@ struct Tiered : QdotModel {
       return call(*m);
     }
     last = first.get();
-    Clock::time_point t0 = Clock::now();
-    int status = call(*first);
-    firstSeconds += secondsBetween(t0, Clock::now());
-    ++firstCalls;
+    int status = 0;
+    if (++firstCalls % kTimeEvery == 0) {
+      Clock::time_point t0 = Clock::now();
+      status = call(*first);
+      firstSeconds += kTimeEvery * secondsBetween(t0, Clock::now());
+    } else {
+      status = call(*first);
+    }
     consider();
     return status;
   }

@@ -31,10 +31,11 @@ using TierCompiler = std::function<ModelPtr(const std::atomic<bool>& cancel)>;
 struct TierObservation {
   double progress = 0;          ///< fraction of the horizon simulated (0 until setTierHorizon)
   double elapsedSeconds = 0;    ///< wall time since the tiered model was created
-  double firstTierSeconds = 0;  ///< wall time inside residual and Jacobian calls on the first tier
+  double firstTierSeconds = 0;  ///< wall time inside residual and Jacobian calls on the first tier (sampled)
   uint64_t firstTierCalls = 0;  ///< residual and Jacobian calls on the first tier
-  /// The same over the recent part of the run (its last half to three quarters of first-tier
-  /// time): early steps are short, so the rate since the start would understate the progress.
+  /// The same over the recent part of the run (the last half to three quarters of the progress):
+  /// the solver's steps grow from a tiny first one, so the rate since the start would understate
+  /// the progress, and a few calls alone say little on a busy machine.
   double recentProgress = 0;
   double recentFirstTierSeconds = 0;
 };

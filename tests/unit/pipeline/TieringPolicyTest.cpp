@@ -45,11 +45,19 @@ TEST(TieringPolicy, TheEndOfARunDoesNotCompile) {
 }
 
 TEST(TieringPolicy, DecidesOnlyOnceItHasSeenEnough) {
-  // The projection is large, but the VM calls so far (1 ms) are less than a tenth of the compile.
-  EXPECT_FALSE(decideTiering(steadyRun(0.0001, 0.002, 0.001), 0.05).compile);
-  // No progress yet (the start values are being solved): nothing to extrapolate from.
-  rt::TierObservation solvingStart = steadyRun(0, 0.5, 0.4);
-  EXPECT_FALSE(decideTiering(solvingStart, 0.05).compile);
+  TieringRule eager;
+  eager.minObserved = 0;
+  eager.minProgress = 0;
+  // The projection repays the compile, but the VM calls so far (5 ms) are less than a tenth of it.
+  rt::TierObservation fewCalls = steadyRun(0.01, 0.006, 0.005);
+  EXPECT_FALSE(decideTiering(fewCalls, 0.1).compile);
+  EXPECT_TRUE(decideTiering(fewCalls, 0.1, eager).compile);
+  // The solver's first steps are tiny: below 1 % of the horizon the rate says little.
+  rt::TierObservation early = steadyRun(0.005, 0.025, 0.02);
+  EXPECT_FALSE(decideTiering(early, 0.05).compile);
+  EXPECT_TRUE(decideTiering(early, 0.05, eager).compile);
+  // No progress yet (the start values are being solved, or no horizon): nothing to extrapolate from.
+  EXPECT_FALSE(decideTiering(steadyRun(0, 0.5, 0.4), 0.05, eager).compile);
 }
 
 TEST(TieringPolicy, TheRecentRateCountsNotTheRateSinceTheStart) {

@@ -1,0 +1,111 @@
+#!/usr/bin/env python3
+"""Tiering benchmark: is `qdot run`'s default (the tiering policy: the VM at once, the LLVM JIT only
+when the policy expects it to pay) ever slower than the better of the two fixed choices?
+
+Runs every example model (examples/**/*.qd, its own experiment settings) and the benchmark models
+(the spring chain at n = 1 000, 10 000, 100 000 and the 8-link pendulum, with the stop times of
+sim_bench.py and jit_bench.py) as whole `qdot run` commands in three modes, interleaved:
+  default   qdot run                          (the tiering policy)
+  bytecode  qdot run --backend bytecode       (the VM only)
+  jit-wait  qdot run --backend llvm --jit-wait  (the JIT compiles before the first step)
+REPEAT times each, and prints a markdown table of the median wall times, the ratio
+default / min(bytecode, jit-wait) (the target: at most 1.10) and what the policy decided (--stats).
+Usage: tiering_bench.py --build DIR [--quick]   (from the repository root)
+  --quick: one repetition, no n = 100 000 chain."""
+import argparse
+import glob
+import os
+import re
+import statistics
+import subprocess
+import sys
+import time
+
+CHAIN = "examples/vibration/spring_chain.qd"
+PENDULUM = "examples/pendulum/nlink.qd"
+MODES = {"default": [], "bytecode": ["--backend", "bytecode"], "jit-wait": ["--backend", "llvm", "--jit-wait"]}
+TARGET = 1.10
+
+
+def benchmark_cases(quick):
+    """(title, model, options): the models of sim_bench.py and jit_bench.py."""
+    cases = [("N-link pendulum n = 8", PENDULUM, ["-p", "n=8", "--stop", "10", "--interval", "0.01"])]
+    sizes = [(1000, 40.0), (10000, 2.0)] + ([] if quick else [(100000, 0.5)])
+    for n, stop in sizes:
+        cases.append((f"spring chain n = {n}", CHAIN,
+                      ["-p", f"n={n}", "--stop", repr(stop), "--outputs", f"x[1],x[{n}]"]))
+    return cases
+
+
+def example_cases():
+    return [(os.path.relpath(path, "examples"), path, []) for path in sorted(glob.glob("examples/**/*.qd", recursive=True))]
+
+
+def timed_run(build, model, options, mode):
+    """One `qdot run --stats`: (wall seconds, stderr)."""
+    command = [f"{build}/qdot", "run", model, "--stats", "-o", os.devnull] + options + MODES[mode]
+    start = time.perf_counter()
+    done = subprocess.run(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    wall = time.perf_counter() - start
+    if done.returncode != 0:
+        sys.exit(f"tiering_bench: {' '.join(command)} failed:\n{done.stderr}")
+    return wall, done.stderr
+
+
+def decision(log):
+    """What the tiering policy did, from the default run's --stats."""
+    started = re.search(r"tiering: compile started ([0-9.e+-]+) ms into the run, at ([0-9.e+-]+) %", log)
+    if not started:
+        return "VM only"
+    ready = re.search(r"jit: native code ready ([0-9.e+-]+) ms", log)
+    when = f"JIT from {float(started.group(2)):.2g} % of the horizon"
+    return when + (f", native at {float(ready.group(1)) / 1e3:.2f} s" if ready else ", run ended first")
+
+
+def measure(build, case, repeat):
+    """Median wall per mode (the modes interleaved, so a slow moment of the machine hits all three)
+    and the default run's last --stats log."""
+    _, model, options = case
+    walls = {mode: [] for mode in MODES}
+    log = ""
+    for _ in range(repeat):
+        for mode in MODES:
+            wall, stderr = timed_run(build, model, options, mode)
+            walls[mode].append(wall)
+            if mode == "default":
+                log = stderr
+    return {mode: statistics.median(w) for mode, w in walls.items()}, log
+
+
+def print_table(rows):
+    print("| model | options | default [s] | bytecode [s] | jit-wait [s] | default / best | policy |")
+    print("| --- | --- | ---: | ---: | ---: | ---: | --- |")
+    for (title, _, options), medians, log in rows:
+        ratio = medians["default"] / min(medians["bytecode"], medians["jit-wait"])
+        cell = f"**{ratio:.2f}**" if ratio > TARGET else f"{ratio:.2f}"
+        print(f"| {title} | {' '.join(options)} | {medians['default']:.3f} | {medians['bytecode']:.3f} "
+              f"| {medians['jit-wait']:.3f} | {cell} | {decision(log)} |")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--build", required=True, help="build directory holding qdot")
+    parser.add_argument("--quick", action="store_true", help="one repetition, no n = 100 000 chain")
+    parser.add_argument("--repeat", type=int, default=None, help="repetitions per mode (default 5, 1 with --quick)")
+    args = parser.parse_args()
+    repeat = args.repeat or (1 if args.quick else 5)
+    rows = []
+    for case in benchmark_cases(args.quick) + example_cases():
+        medians, log = measure(args.build, case, repeat)
+        rows.append((case, medians, log))
+        print(f"tiering_bench: {case[0]}: {medians}", file=sys.stderr, flush=True)
+    print(f"\n## Tiering: the default against the VM alone and the JIT first ({repeat} runs each, median wall)\n")
+    print_table(rows)
+    worst = max(rows, key=lambda r: r[1]["default"] / min(r[1]["bytecode"], r[1]["jit-wait"]))
+    ratio = worst[1]["default"] / min(worst[1]["bytecode"], worst[1]["jit-wait"])
+    over = sum(1 for _, m, _ in rows if m["default"] > TARGET * min(m["bytecode"], m["jit-wait"]))
+    print(f"\nWorst ratio {ratio:.2f} ({worst[0][0]}); {over} of {len(rows)} models above {TARGET:.2f}.")
+
+
+if __name__ == "__main__":
+    main()
