@@ -13,9 +13,9 @@ namespace {
 // ... 100 000) and the N-link pendulum while the solver runs beside the compile thread on the two
 // cores (compiler/driver/README.md): two to ten times what an idle machine takes, so the policy
 // errs towards staying on the VM.
-constexpr double kSecondsPerOptimisedInstruction = 50e-6;
+constexpr double kSecondsPerOptimisedInstruction = 80e-6;
 constexpr double kSecondsPerPlainInstruction = 4e-6;
-constexpr double kSecondsPerUnit = 2e-3;
+constexpr double kSecondsPerUnit = 10e-3;
 
 }  // namespace
 
