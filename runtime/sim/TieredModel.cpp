@@ -1,5 +1,5 @@
 // Every residual and Jacobian call goes to the second tier once it has been published (one acquire
-// load per call), else to the first, timed (a sample); every other call goes to the first. The table (names,
+// load per call), else to the first, timed (all or a sample); every other call goes to the first. The table (names,
 // sizes, Jacobian pattern) is the first tier's: both tiers are built from the same kernels.
 // lastError asks whichever tier made the last call. The ABI hands out const pointers to the model,
 // but the tiered model is ours and mutable: its counters and the trigger live on the solver thread.
@@ -16,9 +16,11 @@ using Clock = std::chrono::steady_clock;
 
 // First-tier calls between two questions to the trigger (a few floating-point operations).
 constexpr uint64_t kAskEvery = 8;
-// One first-tier call in kTimeEvery is timed and counts kTimeEvery times: reading the clock twice
-// costs about as much as a call of the smallest models, which the solver may make millions of.
-constexpr uint64_t kTimeEvery = 4;
+// Calls of at least kLongCall are all timed; shorter ones one in kSparse, counting kSparse times:
+// reading the clock twice costs about as much as a call of the smallest models, which the solver
+// may make millions of.
+constexpr double kLongCall = 2e-6;
+constexpr uint64_t kSparse = 16;
 // A timed call longer than kOutlier x the mean of the samples so far (once there are
 // kSamplesBeforeOutliers) was interrupted: VM calls of one model differ by less (a Jacobian costs a
 // few residuals).
@@ -55,6 +57,7 @@ struct Tiered : QdotModel {
   const QdotModel* last = nullptr;
   uint64_t firstCalls = 0, secondCalls = 0;
   double firstSeconds = 0;
+  uint64_t timeEvery = 1, untilTimed = 1;  // calls per timed call, calls until the next one
   bool hasHorizon = false;
   double start = 0, stop = 0, latest = 0;
   bool started = false;
@@ -101,10 +104,22 @@ struct Tiered : QdotModel {
   // One timed call, as counted: on a busy machine the solver thread is sometimes descheduled in
   // the middle of one, for milliseconds; a sample far above the mean so far counts as the mean.
   double sample(double seconds) const {
-    uint64_t samples = firstCalls / kTimeEvery - 1;  // before this one
-    double mean = samples > 0 ? firstSeconds / kTimeEvery / double(samples) : 0;
-    if (samples >= kSamplesBeforeOutliers && seconds > kOutlier * mean) return mean;
+    uint64_t before = firstCalls - 1;
+    double mean = before > 0 ? firstSeconds / double(before) : 0;
+    if (before >= kSamplesBeforeOutliers && seconds > kOutlier * mean) return mean;
     return std::max(0.0, seconds);
+  }
+
+  // Times the call if it is its turn.
+  template <class Call>
+  int timed(Call call) {
+    if (--untilTimed > 0) return call(*first);
+    Clock::time_point t0 = Clock::now();
+    int status = call(*first);
+    firstSeconds += double(timeEvery) * sample(secondsBetween(t0, Clock::now()) - clockReadSeconds());
+    timeEvery = firstSeconds < kLongCall * double(firstCalls) ? kSparse : 1;
+    untilTimed = timeEvery;
+    return status;
   }
 
   // A residual or Jacobian call: the second tier once published, else the first, timed.
@@ -116,14 +131,8 @@ struct Tiered : QdotModel {
       return call(*m);
     }
     last = first.get();
-    int status = 0;
-    if (++firstCalls % kTimeEvery == 0) {
-      Clock::time_point t0 = Clock::now();
-      status = call(*first);
-      firstSeconds += kTimeEvery * sample(secondsBetween(t0, Clock::now()) - clockReadSeconds());
-    } else {
-      status = call(*first);
-    }
+    ++firstCalls;
+    int status = timed(call);
     consider();
     return status;
   }
