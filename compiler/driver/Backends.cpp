@@ -42,22 +42,40 @@ bool loadBytecode(Compilation& c, RunnableModel& out) {
   return out.model != nullptr;
 }
 
-// Wraps out.model (the VM) in a tiered model whose second tier the JIT compiles in the background,
-// leaving one core to the solver. The compile thread holds the kernels and its own copy of the
-// sources, so nothing it reads can go away while it runs.
-void addBackgroundJit(const Compilation& c, bool invariants, RunnableModel& out) {
-  llvmbackend::JitOptions options = llvmbackend::jitOptionsForRun(invariants);
+// What the background JIT compiles: the residual and the Jacobian (the tiered model sends only
+// those to it), on one thread fewer than cores so the solver keeps a core.
+llvmbackend::JitOptions backgroundJitOptions() {
+  llvmbackend::JitOptions options = llvmbackend::jitOptionsForRun(false);
+  options.compiledPrograms = llvmbackend::programBit(ModelProgram::Residual) |
+                             llvmbackend::programBit(ModelProgram::Jacobian);
   options.threads = std::max(2u, std::thread::hardware_concurrency()) - 1;
+  return options;
+}
+
+// The tiering policy's trigger for a compile estimated at `estimate` (TieringPolicy.h).
+rt::TierTrigger policyTrigger(const CompileEstimate& estimate) {
+  return [seconds = estimate.cpuSeconds](const rt::TierObservation& seen) {
+    return decideTiering(seen, seconds).compile;
+  };
+}
+
+// Wraps out.model (the VM) in a tiered model whose second tier the JIT compiles in the background
+// once `trigger` says so (at once without one). The compile thread holds the kernels and its own
+// copy of the sources, so nothing it reads can go away while it runs.
+void addBackgroundJit(const Compilation& c, rt::TierTrigger trigger, RunnableModel& out) {
+  llvmbackend::JitOptions options = backgroundJitOptions();
   auto sources = std::make_shared<const SourceManager>(c.sources);
   out.what = "bytecode then llvm";
   out.model = rt::createTieredModel(
-      std::move(out.model), [kernels = c.kernels, sources, options, jit = out.jit](const std::atomic<bool>& cancel) {
+      std::move(out.model),
+      [kernels = c.kernels, sources, options, jit = out.jit](const std::atomic<bool>& cancel) {
         llvmbackend::JitOptions withCancel = options;
         withCancel.cancel = &cancel;
         Result<ModelPtr> model = llvmbackend::createJitModel(*kernels, *sources, withCancel, &jit->stats);
         if (!model) jit->error = model.error();
         return model ? std::move(model).value() : ModelPtr();
-      });
+      },
+      std::move(trigger));
 }
 
 }  // namespace
@@ -72,10 +90,39 @@ RunnableModel makeRunnableModel(Compilation& c, Backend backend, bool invariants
     }
     out.warning = "the LLVM JIT failed (" + out.jit->error + "); running on the bytecode VM instead";
   }
-  if (loadBytecode(c, out) && backend == Backend::Tiered) addBackgroundJit(c, invariants, out);
+  if (loadBytecode(c, out) && backend == Backend::Tiered) {
+    out.jitEstimate = estimateCompile(*c.kernels, backgroundJitOptions(), backgroundJitOptions().threads);
+    addBackgroundJit(c, policyTrigger(out.jitEstimate), out);
+  } else if (out.model && backend == Backend::Background) {
+    addBackgroundJit(c, {}, out);
+  }
   out.codegenSeconds = secondsSince(t0);
   return out;
 }
+
+namespace {
+
+// --stats: what the tiering policy weighed and decided.
+void printTieringDecision(const RunnableModel& m, const rt::TierReport& tiers, std::ostream& log) {
+  const CompileEstimate& e = m.jitEstimate;
+  const rt::TierObservation& seen = tiers.startedAt;
+  log << "tiering: the JIT of the residual and Jacobian (" << e.optimisedInstructions << " kernel instructions at level 2, "
+      << e.plainInstructions << " at level 0, " << e.units << " modules) is estimated at " << e.cpuSeconds * 1e3
+      << " ms of CPU on " << e.threads << " thread(s)\n";
+  TierVerdict v = decideTiering(seen, e.cpuSeconds);
+  if (tiers.started) {
+    log << "tiering: compile started " << seen.elapsedSeconds * 1e3 << " ms into the run, at " << seen.progress * 100
+        << " % of the horizon: the VM had spent " << seen.firstTierSeconds * 1e3 << " ms in " << seen.firstTierCalls
+        << " residual/Jacobian calls, projecting " << v.remainingVmSeconds * 1e3 << " ms more, of which native code saves ~"
+        << v.savingSeconds * 1e3 << " ms (>= " << TieringRule{}.payback << " x the compile)\n";
+  } else {
+    log << "tiering: stayed on the VM: its " << seen.firstTierCalls << " residual/Jacobian calls took "
+        << seen.firstTierSeconds * 1e3 << " ms of the run's " << seen.elapsedSeconds * 1e3
+        << " ms; native code would never have saved " << TieringRule{}.payback << " x the compile\n";
+  }
+}
+
+}  // namespace
 
 std::optional<rt::TierReport> reportTiers(const RunnableModel& m, bool stats, std::ostream& log) {
   std::optional<rt::TierReport> tiers = rt::tierReport(m.model.get());
@@ -84,13 +131,15 @@ std::optional<rt::TierReport> reportTiers(const RunnableModel& m, bool stats, st
   bool failed = !tiers->compiling && !tiers->ready && !jit.error.empty() && jit.error != "cancelled";
   if (failed) log << "qdot: warning: the LLVM JIT failed (" << jit.error << "); the run stayed on the bytecode VM\n";
   if (!stats) return tiers;
+  if (m.jitEstimate.units > 0) printTieringDecision(m, *tiers, log);
   if (tiers->ready) {
     log << "jit: native code ready " << tiers->readySeconds * 1e3 << " ms after the VM started; "
-        << tiers->firstTierCalls << " model calls on the VM, " << tiers->secondTierCalls << " on native code\n";
+        << tiers->firstTierCalls << " residual/Jacobian calls on the VM, " << tiers->secondTierCalls
+        << " on native code\n";
     printJitStats(jit.stats, log);
-  } else if (!failed) {
+  } else if (tiers->started && !failed) {
     log << "jit: the run ended before the native code was ready (all " << tiers->firstTierCalls
-        << " model calls on the VM)\n";
+        << " residual/Jacobian calls on the VM)\n";
   }
   return tiers;
 }

@@ -11,6 +11,7 @@
 
 #include "output/CsvWriter.h"
 #include "sim/StatsReport.h"
+#include "sim/TieredModel.h"
 
 namespace qdot::rt {
 namespace {
@@ -49,6 +50,7 @@ ExitCode runModel(const QdotModel& model, const RunOptions& options, const Exper
   }
   // Progress only where a person watches: standard error is a terminal (never into a log file).
   if (run.progress && &log == &std::cerr && isatty(STDERR_FILENO)) run.settings.progress = &log;
+  setTierHorizon(&model, run.settings.start, run.settings.stop);  // the tiering policy's progress
   SimulationResult result = simulate(model, run.settings, *writer);
   report(result, run.stats, log);
   return result.success ? ExitCode::Success : ExitCode::SimulationFailed;

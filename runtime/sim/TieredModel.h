@@ -4,6 +4,11 @@
 // the VM do: tests/unit/llvm, tests/cli/backends_test.sh), so where the switch falls changes
 // nothing in the results, only in the time they take: short runs never wait for the compiler and
 // long ones run on native code for all but their first moments.
+// Whether and when the compile starts is a trigger's decision (the tiering policy, driver/
+// TieringPolicy.h): it sees what the first tier has cost so far and how far the run has got, so a
+// run whose model calls are cheap never pays for a compiler competing with the solver.
+// Only the residual and the Jacobian (the calls IDA repeats) go to the second tier; parameters,
+// start values, outputs and invariants (once per run or per output row) stay on the first.
 #pragma once
 
 #include <atomic>
@@ -22,19 +27,44 @@ namespace qdot::rt {
 /// returning null, once `cancel` is set (the run ended before it was done).
 using TierCompiler = std::function<ModelPtr(const std::atomic<bool>& cancel)>;
 
+/// What a trigger sees: the run so far, on the first tier.
+struct TierObservation {
+  double progress = 0;          ///< fraction of the horizon simulated (0 until setTierHorizon)
+  double elapsedSeconds = 0;    ///< wall time since the tiered model was created
+  double firstTierSeconds = 0;  ///< wall time inside residual and Jacobian calls on the first tier (sampled)
+  uint64_t firstTierCalls = 0;  ///< residual and Jacobian calls on the first tier
+  /// The same over the recent part of the run (the last half to three quarters of the progress):
+  /// the solver's steps grow from a tiny first one, so the rate since the start would understate
+  /// the progress, and a few calls alone say little on a busy machine.
+  double recentProgress = 0;
+  double recentFirstTierSeconds = 0;
+};
+
+/// Decides, on the solver thread, whether the compile starts now. Asked every few residual calls
+/// until it says yes; a null trigger starts the compile at once.
+using TierTrigger = std::function<bool(const TierObservation&)>;
+
 /// What happened to the second tier so far.
 struct TierReport {
+  bool started = false;         ///< the trigger started the compile
+  TierObservation startedAt;    ///< what the trigger saw when it did (if it never did: the run so far)
   bool compiling = false;       ///< the compile thread is still running
   bool ready = false;           ///< the second tier was compiled and is in use
   double readySeconds = 0;      ///< when, after the tiered model was created (wall)
-  uint64_t firstTierCalls = 0;  ///< calls made on the first tier (all calls if never ready)
+  uint64_t firstTierCalls = 0;  ///< residual and Jacobian calls on the first tier (all if never ready)
   uint64_t secondTierCalls = 0;
+  double firstTierSeconds = 0;  ///< wall time inside them
 };
 
 /// Creates the tiered model; owns `first` and whatever `compile` returns. compile runs on its own
-/// thread at once. destroy() cancels and joins it (a program about to exit need not wait for it:
-/// qdot run ends with _Exit when the compile is still running, tierReport().compiling).
-ModelPtr createTieredModel(ModelPtr first, TierCompiler compile);
+/// thread once `trigger` says so (at once without a trigger). destroy() cancels and joins it (a
+/// program about to exit need not wait for it: qdot run ends with _Exit when the compile is still
+/// running, tierReport().compiling).
+ModelPtr createTieredModel(ModelPtr first, TierCompiler compile, TierTrigger trigger = {});
+
+/// Tells a tiered model the simulated interval [start, stop], from which it reports the progress
+/// of a run (the largest time of a residual call); does nothing for any other model.
+void setTierHorizon(const QdotModel* model, double start, double stop);
 
 /// The report of a model made by createTieredModel, without waiting; nullopt for any other model.
 /// Call it from the thread that calls the model. Once `compiling` is false, whatever the compile

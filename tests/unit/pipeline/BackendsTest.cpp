@@ -28,7 +28,7 @@ TEST(Backends, TieredModelOutlivesItsCompilation) {
   {
     Compilation c;
     ASSERT_TRUE(compileSource(c, "utube.qd", text, "", Stage::Kernel));
-    tiered = makeRunnableModel(c, Backend::Tiered, false);
+    tiered = makeRunnableModel(c, Backend::Background, false);
     ASSERT_TRUE(tiered.model) << tiered.error;
     EXPECT_EQ(tiered.what, "bytecode then llvm");
   }  // the kernels and sources of the compilation go away while the JIT may still be compiling
@@ -88,6 +88,28 @@ TEST(Pipeline, AMissingFileIsOneError) {
   Compilation c;
   EXPECT_FALSE(compileFile(c, "/does/not/exist.qd", "", Stage::Parse));
   ASSERT_EQ(c.diags.errorCount(), 1u);
+}
+
+// The default backend weighs the JIT before compiling: a short run on a small model (the U-tube's
+// residual costs well under a microsecond on the VM) never starts the compiler.
+TEST(Backends, TheDefaultDoesNotCompileForAShortRun) {
+  Compilation c;
+  ASSERT_TRUE(compileSource(c, "utube.qd", test::readSource("examples/textbook/utube.qd"), "", Stage::Kernel));
+  RunnableModel m = makeRunnableModel(c, Backend::Tiered, false);
+  ASSERT_TRUE(m.model) << m.error;
+  EXPECT_EQ(m.what, "bytecode then llvm");
+  EXPECT_GT(m.jitEstimate.cpuSeconds, 0);
+  rt::setTierHorizon(m.model.get(), 0, 1);
+  std::vector<double> p(m.model->nParameters), y(m.model->nVariables, 0.03), yp(m.model->nVariables, -0.2);
+  std::vector<double> F(m.model->nVariables);
+  ASSERT_EQ(m.model->parameters(m.model.get(), nullptr, nullptr, p.data()), 0);
+  for (int k = 1; k <= 100; ++k)  // the whole horizon in 100 calls
+    ASSERT_EQ(m.model->residual(m.model.get(), k / 100.0, y.data(), yp.data(), p.data(), F.data()), 0);
+  rt::TierReport report = *rt::tierReport(m.model.get());
+  EXPECT_FALSE(report.started);
+  EXPECT_FALSE(report.compiling);
+  EXPECT_EQ(report.firstTierCalls, 100u);
+  EXPECT_DOUBLE_EQ(report.startedAt.progress, 1.0);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "sim/TieredModel.h"
 
@@ -32,6 +33,10 @@ ModelPtr standIn(double value, std::atomic<int>* destroyed) {
     F[0] = static_cast<const StandIn*>(s)->value;
     return 0;
   };
+  m->outputs = [](const QdotModel* s, double, const double*, const double*, const double*, double* out) {
+    out[0] = static_cast<const StandIn*>(s)->value;
+    return 0;
+  };
   m->lastError = [](const QdotModel* s) { return static_cast<const StandIn*>(s)->error.c_str(); };
   m->destroy = [](QdotModel* s) {
     auto* self = static_cast<StandIn*>(s);
@@ -41,10 +46,23 @@ ModelPtr standIn(double value, std::atomic<int>* destroyed) {
   return ModelPtr(m);
 }
 
-double residualOf(const QdotModel* m) {
+double residualOf(const QdotModel* m, double t = 0) {
   double y = 0, yp = 0, F = -1;
-  EXPECT_EQ(m->residual(m, 0, &y, &yp, nullptr, &F), 0);
+  EXPECT_EQ(m->residual(m, t, &y, &yp, nullptr, &F), 0);
   return F;
+}
+
+double outputOf(const QdotModel* m) {
+  double y = 0, yp = 0, out = -1;
+  EXPECT_EQ(m->outputs(m, 0, &y, &yp, nullptr, &out), 0);
+  return out;
+}
+
+// Calls the residual until the second tier answers (bounded by a deadline).
+void waitForTheSecondTier(const QdotModel* m) {
+  auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while ((residualOf(m) != 2.0 || tierReport(m)->compiling) && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::yield();
 }
 
 TEST(TieredModel, RunsTheFirstTierUntilTheSecondIsReadyThenTheSecond) {
@@ -106,6 +124,49 @@ TEST(TieredModel, ASecondTierFinishedAfterTheRunIsReleasedUnused) {
   EXPECT_EQ(residualOf(m), 1.0);
   tiered.reset();
   EXPECT_EQ(destroyed.load(), 2);
+}
+
+TEST(TieredModel, TheTriggerStartsTheCompileAndSeesTheProgress) {
+  std::atomic<int> destroyed{0};
+  std::vector<TierObservation> seen;
+  ModelPtr tiered = createTieredModel(
+      standIn(1.0, &destroyed), [&](const std::atomic<bool>&) { return standIn(2.0, &destroyed); },
+      [&](const TierObservation& o) {
+        seen.push_back(o);
+        return o.progress >= 0.5;
+      });
+  QdotModel* m = tiered.get();
+  setTierHorizon(m, 10, 20);
+  for (int k = 1; k < 40; ++k) EXPECT_EQ(residualOf(m, 10 + k * 0.1), 1.0);  // up to t = 13.9
+  std::optional<TierReport> report = tierReport(m);
+  EXPECT_FALSE(report->started);
+  EXPECT_FALSE(report->compiling);
+  EXPECT_NEAR(report->startedAt.progress, 0.39, 1e-12);
+  ASSERT_FALSE(seen.empty());
+  EXPECT_NEAR(seen.front().progress, 0.08, 1e-12);  // asked first after 8 calls, at t = 10.8
+  for (size_t i = 1; i < seen.size(); ++i) {
+    EXPECT_GT(seen[i].progress, seen[i - 1].progress);
+    EXPECT_GT(seen[i].recentProgress, 0);
+    EXPECT_LE(seen[i].recentProgress, seen[i].progress);
+    EXPECT_GE(seen[i].firstTierSeconds, seen[i - 1].firstTierSeconds);
+  }
+  for (int k = 40; k <= 60; ++k) residualOf(m, 10 + k * 0.1);
+  EXPECT_TRUE(tierReport(m)->started);
+  EXPECT_GE(tierReport(m)->startedAt.progress, 0.5);
+  waitForTheSecondTier(m);
+  EXPECT_EQ(residualOf(m), 2.0);
+}
+
+TEST(TieredModel, OnlyTheResidualAndJacobianMoveToTheSecondTier) {
+  std::atomic<int> destroyed{0};
+  ModelPtr tiered = createTieredModel(standIn(1.0, &destroyed), [&](const std::atomic<bool>&) {
+    return standIn(2.0, &destroyed);
+  });
+  QdotModel* m = tiered.get();
+  waitForTheSecondTier(m);
+  EXPECT_EQ(residualOf(m), 2.0);
+  EXPECT_EQ(outputOf(m), 1.0);  // once per output row: not worth compiling
+  EXPECT_STREQ(m->lastError(m), "tier 1");
 }
 
 TEST(TieredModel, ReportIsOnlyForTieredModels) {

@@ -1,0 +1,49 @@
+// estimateCompile and decideTiering: see TieringPolicy.h.
+#include "driver/TieringPolicy.h"
+
+#include <algorithm>
+
+#include "llvm/CompilePlan.h"
+
+namespace qdot::driver {
+namespace {
+
+// CPU seconds per kernel instruction at each code generator level and per module (a pass
+// pipeline, an object file to link), measured by `qdot run --stats` on the spring chain (n = 1 000
+// ... 100 000) and the N-link pendulum while the solver runs beside the compile thread on the two
+// cores (compiler/driver/README.md): two to ten times what an idle machine takes, so the policy
+// errs towards staying on the VM.
+constexpr double kSecondsPerOptimisedInstruction = 80e-6;
+constexpr double kSecondsPerPlainInstruction = 4e-6;
+constexpr double kSecondsPerUnit = 10e-3;
+
+}  // namespace
+
+CompileEstimate estimateCompile(const kernel::KernelModule& k, const llvmbackend::JitOptions& options,
+                                unsigned threads) {
+  CompileEstimate e;
+  e.threads = std::max(1u, threads);
+  llvmbackend::CompilePlan plan = llvmbackend::planCompile(k, options, e.threads);
+  for (const llvmbackend::PlannedUnit& unit : plan.units)
+    (unit.level >= 2 ? e.optimisedInstructions : e.plainInstructions) += unit.instructions;
+  e.units = plan.units.size();
+  e.cpuSeconds = double(e.optimisedInstructions) * kSecondsPerOptimisedInstruction +
+                 double(e.plainInstructions) * kSecondsPerPlainInstruction + double(e.units) * kSecondsPerUnit;
+  return e;
+}
+
+TierVerdict decideTiering(const rt::TierObservation& seen, double compileSeconds, const TieringRule& rule) {
+  TierVerdict v;
+  // Nothing to extrapolate from yet (the start values are still being solved, or no horizon).
+  if (seen.recentProgress <= 0 || seen.elapsedSeconds <= 0) return v;
+  v.remainingVmSeconds = seen.recentFirstTierSeconds * (1 - seen.progress) / seen.recentProgress;
+  // While it compiles the run stays on the VM, spending the share of its time it spent so far.
+  double duringCompile = compileSeconds * std::min(1.0, seen.firstTierSeconds / seen.elapsedSeconds);
+  double afterCompile = std::max(0.0, v.remainingVmSeconds - duringCompile);
+  v.savingSeconds = afterCompile * (1 - 1 / rule.nativeSpeedup);
+  v.compile = seen.progress >= rule.minProgress && seen.firstTierSeconds >= rule.minObserved * compileSeconds &&
+              v.savingSeconds >= rule.payback * compileSeconds;
+  return v;
+}
+
+}  // namespace qdot::driver

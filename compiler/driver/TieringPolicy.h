@@ -1,0 +1,57 @@
+// TieringPolicy: whether, when and how much qdot run compiles with the LLVM JIT while the VM runs
+// (Backend::Tiered, Backends.h). Plain functions of numbers, so tests check the decisions.
+//   How much: only the residual and the Jacobian (the calls IDA repeats; the rest runs once per run
+//     or per output row and stays on the VM), on one thread fewer than cores (the solver keeps one).
+//   Whether and when: the run starts on the VM, which times its residual and Jacobian calls. Every
+//     few calls the policy extrapolates from the recent progress through the horizon how much VM time in
+//     those calls is still to come, and starts the compile once native code (rule.nativeSpeedup
+//     times faster) would save rule.payback times the estimated compile time. The compile competes
+//     with the solver for the machine, so on a loaded two-core machine its whole CPU time may add
+//     to the run: the payback factor keeps a run from ever losing more than a fraction of what it
+//     gains, and a run whose model calls are cheap (most of its time in the linear solver, or short)
+//     never compiles. Why and when is printed by --stats (reportTiers).
+#pragma once
+
+#include <cstddef>
+
+#include "llvm/JitModel.h"
+#include "sim/TieredModel.h"
+
+namespace qdot::kernel {
+struct KernelModule;
+}
+
+namespace qdot::driver {
+
+/// The JIT work of one model under one set of JIT options.
+struct CompileEstimate {
+  size_t optimisedInstructions = 0;  ///< kernel instructions compiled at code generator level 2
+  size_t plainInstructions = 0;      ///< at level 0
+  size_t units = 0;                  ///< LLVM modules (each has a fixed cost)
+  unsigned threads = 1;
+  double cpuSeconds = 0;  ///< expected CPU time on this machine when idle (summed over threads)
+};
+
+/// The compile plan's work for `k` (llvmbackend::planCompile) priced at the rates measured on the
+/// benchmark models (compiler/driver/README.md).
+CompileEstimate estimateCompile(const kernel::KernelModule& k, const llvmbackend::JitOptions& options,
+                                unsigned threads);
+
+/// The constants of the decision; the defaults are the measured ones (compiler/driver/README.md).
+struct TieringRule {
+  double nativeSpeedup = 4;  ///< VM / native time of a residual or Jacobian call (measured 5.7-17)
+  double payback = 2;        ///< the projected saving must exceed this many compile CPU times
+  double minObserved = 0.1;  ///< decide only once the VM calls took this fraction of the compile
+  double minProgress = 0.01;  ///< and the run got this far (past the solver's first, tiny steps)
+};
+
+struct TierVerdict {
+  bool compile = false;
+  double remainingVmSeconds = 0;  ///< VM time in residual and Jacobian calls still to come
+  double savingSeconds = 0;       ///< what native code would save of it, after the compile
+};
+
+/// The decision on what the run has shown so far (`seen`), for a compile of `compileSeconds`.
+TierVerdict decideTiering(const rt::TierObservation& seen, double compileSeconds, const TieringRule& rule = {});
+
+}  // namespace qdot::driver

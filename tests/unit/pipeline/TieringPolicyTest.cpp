@@ -1,0 +1,95 @@
+// The tiering policy (driver/TieringPolicy.h) on given observations: it compiles when the VM time
+// still to come, extrapolated from the recent progress, repays the compile several times, and not
+// before it has seen enough of the run; and the compile estimate follows the compile plan.
+#include <gtest/gtest.h>
+
+#include "driver/Pipeline.h"
+#include "driver/TieringPolicy.h"
+#include "unit/pipeline/CompiledModel.h"
+
+namespace qdot::driver {
+namespace {
+
+// A run at `progress` after `elapsed` s, `vm` s of it in VM calls, all at a steady rate.
+rt::TierObservation steadyRun(double progress, double elapsed, double vm) {
+  rt::TierObservation seen;
+  seen.progress = progress;
+  seen.elapsedSeconds = elapsed;
+  seen.firstTierSeconds = vm;
+  seen.firstTierCalls = 1000;
+  seen.recentProgress = progress / 2;  // the recent window: the second half of the VM time
+  seen.recentFirstTierSeconds = vm / 2;
+  return seen;
+}
+
+TEST(TieringPolicy, ALongRunSpentInModelCallsCompiles) {
+  // 1 % of the horizon took 20 ms of VM calls: about 2 s more to come; a 50 ms compile repays.
+  TierVerdict v = decideTiering(steadyRun(0.01, 0.025, 0.02), 0.05);
+  EXPECT_TRUE(v.compile);
+  EXPECT_NEAR(v.remainingVmSeconds, 1.98, 1e-9);
+  EXPECT_GT(v.savingSeconds, 2 * 0.05);
+  EXPECT_LT(v.savingSeconds, v.remainingVmSeconds);  // native code is not free
+}
+
+TEST(TieringPolicy, ARunWhoseModelCallsAreCheapStaysOnTheVm) {
+  // Half the horizon, 1 s of wall but 50 ms in model calls (the rest in the linear solver): the
+  // 50 ms still to come can never repay a 0.5 s compile.
+  TierVerdict v = decideTiering(steadyRun(0.5, 1.0, 0.05), 0.5);
+  EXPECT_FALSE(v.compile);
+  EXPECT_NEAR(v.remainingVmSeconds, 0.05, 1e-9);
+}
+
+TEST(TieringPolicy, TheEndOfARunDoesNotCompile) {
+  EXPECT_FALSE(decideTiering(steadyRun(0.999, 2.0, 1.9), 0.05).compile);
+  EXPECT_TRUE(decideTiering(steadyRun(0.5, 2.0, 1.9), 0.05).compile);  // the same run halfway
+}
+
+TEST(TieringPolicy, DecidesOnlyOnceItHasSeenEnough) {
+  TieringRule eager;
+  eager.minObserved = 0;
+  eager.minProgress = 0;
+  // The projection repays the compile, but the VM calls so far (5 ms) are less than a tenth of it.
+  rt::TierObservation fewCalls = steadyRun(0.01, 0.006, 0.005);
+  EXPECT_FALSE(decideTiering(fewCalls, 0.1).compile);
+  EXPECT_TRUE(decideTiering(fewCalls, 0.1, eager).compile);
+  // The solver's first steps are tiny: below 1 % of the horizon the rate says little.
+  rt::TierObservation early = steadyRun(0.005, 0.025, 0.02);
+  EXPECT_FALSE(decideTiering(early, 0.05).compile);
+  EXPECT_TRUE(decideTiering(early, 0.05, eager).compile);
+  // No progress yet (the start values are being solved, or no horizon): nothing to extrapolate from.
+  EXPECT_FALSE(decideTiering(steadyRun(0, 0.5, 0.4), 0.05, eager).compile);
+}
+
+TEST(TieringPolicy, TheRecentRateCountsNotTheRateSinceTheStart) {
+  // 10 % of the horizon; the first 8 % took 90 ms of VM time in short steps, the last 2 % 10 ms:
+  // 90 % to go at the recent rate is 0.45 s, not the 0.9 s the average would give.
+  rt::TierObservation seen = steadyRun(0.1, 0.2, 0.1);
+  seen.recentProgress = 0.02;
+  seen.recentFirstTierSeconds = 0.01;
+  TierVerdict v = decideTiering(seen, 0.1);
+  EXPECT_NEAR(v.remainingVmSeconds, 0.45, 1e-9);
+  EXPECT_TRUE(v.compile);
+  EXPECT_FALSE(decideTiering(seen, 0.2).compile);  // what is left after the compile, x 3/4, < 2 x 0.2 s
+}
+
+TEST(TieringPolicy, TheEstimateFollowsTheCompilePlan) {
+  Compilation c;
+  ASSERT_TRUE(compileSource(c, "nlink.qd", test::readSource("examples/pendulum/nlink.qd"), "", Stage::Kernel));
+  llvmbackend::JitOptions hot;
+  hot.compiledPrograms = llvmbackend::programBit(ModelProgram::Residual) | llvmbackend::programBit(ModelProgram::Jacobian);
+  CompileEstimate e = estimateCompile(*c.kernels, hot, 1);
+  const auto& programs = c.kernels->programs;
+  EXPECT_EQ(e.optimisedInstructions, programs[programIndex(ModelProgram::Residual)].code.size());
+  EXPECT_EQ(e.plainInstructions, programs[programIndex(ModelProgram::Jacobian)].code.size());
+  EXPECT_GT(e.cpuSeconds, 0);
+  // Above the large-model size everything is compiled at level 0: cheaper per instruction.
+  llvmbackend::JitOptions large = hot;
+  large.largeModelInstructions = 1;
+  CompileEstimate plain = estimateCompile(*c.kernels, large, 1);
+  EXPECT_EQ(plain.optimisedInstructions, 0u);
+  EXPECT_EQ(plain.plainInstructions, e.optimisedInstructions + e.plainInstructions);
+  EXPECT_LT(plain.cpuSeconds, e.cpuSeconds);
+}
+
+}  // namespace
+}  // namespace qdot::driver
