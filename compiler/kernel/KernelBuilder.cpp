@@ -137,9 +137,10 @@ class Builder {
     // reserved, as a large model has hundreds of thousands (each with two strings to move on growth).
     m_.sources.reserve(dae_.equations.size() + 2 * dae_.variables.size() + dae_.parameters.size() +
                        dae_.initialEquations.size() + dae_.outputs.size() + dae_.invariants.size());
+    // A template block's rows are served by its loop's one source (blockSource), not one each.
     for (size_t i = 0; i < dae_.equations.size(); ++i) {
       const auto& e = dae_.equations[i];
-      equationSource_.push_back(addSource(equationLabel(i, e), e.origin.range, equationText(e)));
+      equationSource_.push_back(e.residual ? addSource(equationLabel(i, e), e.origin.range, equationText(e)) : UINT32_MAX);
     }
   }
 
