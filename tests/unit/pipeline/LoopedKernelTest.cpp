@@ -88,6 +88,22 @@ end Grid;
   EXPECT_EQ(loops, 6u);  // 5 regions of Euler–Lagrange rows and the kinematic rows
 }
 
+TEST(LoopedKernels, NonlinearInertiaAndSecondNeighboursGiveTheScalarResidualAndJacobian) {
+  size_t loops = expectSameKernels(R"(model Skip
+  parameter Integer n = 12;
+  parameter Real k = 100;
+  coordinate Real x[n](start = {sin(i) for i in 1:n});
+  coordinate Real w(start = 0.2);
+mechanics
+  kinetic = sum(0.5*(1 + 0.1*x[i]^2)*der(x[i])^2 for i in 1:n) + 0.5*der(w)^2;
+  potential = sum(0.5*k*(x[i+2] - x[i])^2 for i in 1:n-2) + sum(k*(1 - cos(x[i])) for i in 2:n-1)
+            + 0.5*k*(w - x[5])^2;
+  force(x[7]) = sin(time);
+end Skip;
+)");
+  EXPECT_GE(loops, 3u);  // interior regions split around the peeled x[5] and x[7], and the kinematic rows
+}
+
 TEST(LoopedKernels, PendulumWithoutRepeatedStructureHasNoLoops) {
   EXPECT_EQ(expectSameKernels(R"(model Pendulum
   parameter Real m = 1, l = 1, g = 9.81;
