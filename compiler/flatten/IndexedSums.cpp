@@ -295,18 +295,20 @@ Expr Flattener::rateOfRelative(const RelativeElement& rel) {
 }
 
 Expr ElementPatterns::symbol(sym::Context& ctx, const RelativeElement& rel) {
-  std::string name = arrays[rel.array].name + "[";
+  std::string name = arrays[rel.array].name;
+  name += '[';
   for (size_t d = 0; d < rel.dims.size(); ++d) {
-    if (d) name += ",";
+    if (d) name += ',';
     const auto& dim = rel.dims[d];
-    if (dim.iterator < 0) {
-      name += std::to_string(dim.offset);
-      continue;
+    if (dim.iterator >= 0) {
+      name += '%';
+      name += std::to_string(dim.iterator + 1);
+      if (dim.offset > 0) name += '+';
     }
-    name += "%" + std::to_string(dim.iterator + 1);
-    if (dim.offset) name += (dim.offset > 0 ? "+" : "") + std::to_string(dim.offset);
+    if (dim.iterator < 0 || dim.offset) name += std::to_string(dim.offset);
   }
-  Expr s = ctx.symbol(name + "]");
+  name += ']';
+  Expr s = ctx.symbol(name);
   elements_.try_emplace(s->symbolId, rel);
   return s;
 }
