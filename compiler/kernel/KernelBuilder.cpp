@@ -4,6 +4,8 @@
 // Jacobian, so the residual must not pay for Jacobian-only work.
 #include <unordered_map>
 #include <algorithm>
+#include <cstring>
+#include <optional>
 #include <limits>
 #include <unordered_set>
 
@@ -292,10 +294,13 @@ class Builder {
 
   std::vector<Start> collectStarts() {
     std::vector<Start> starts(dae_.variables.size());
+    std::vector<Expr> declared;
+    for (const auto& v : dae_.variables) declared.push_back(v.declaration.start);
+    std::vector<char> looped = inRuns(numberRuns(declared), declared.size());
     for (size_t j = 0; j < dae_.variables.size(); ++j) {
       const auto& v = dae_.variables[j];
       starts[j].y0 = v.declaration.start;
-      if (v.declaration.start) starts[j].source = addSource("start value of " + v.name, v.declaration.declRange);
+      if (v.declaration.start && !looped[j]) starts[j].source = addSource("start value of " + v.name, v.declaration.declRange);
     }
     startUse_.resize(dae_.variables.size());
     for (size_t j = 0; j < dae_.variables.size(); ++j) {  // as written (fixed = …), else the default
@@ -321,7 +326,8 @@ class Builder {
       if (!(*kept)[j]) m_.description.fixed[j] = kStartGuess;
   }
 
-  // out = [y0 (n), yp0 (n), nominal (n)]; stores of a plain 0 serve no source.
+  // out = [y0 (n), yp0 (n), nominal (n)]; stores of a plain 0 serve no source. Runs of numbers
+  // (a large array's starts, its zero derivatives and nominals) are stored by loops.
   void buildInitialValues() {
     std::vector<Start> starts = collectStarts();
     ProgramBuilder b(programName(ModelProgram::InitialValues));
@@ -331,15 +337,81 @@ class Builder {
       b.setSource(value ? source : UINT32_MAX);
       b.store(slot, value ? b.lower(value) : b.constant(0.0));
     };
-    for (uint32_t j = 0; j < n; ++j) store(j, starts[j].y0, starts[j].source);
-    for (uint32_t j = 0; j < n; ++j) store(n + j, starts[j].yp0, starts[j].derivativeSource);
-    for (uint32_t j = 0; j < n; ++j) {
+    std::vector<Expr> y0, yp0, nominal;
+    for (const Start& st : starts) y0.push_back(st.y0), yp0.push_back(st.yp0);
+    for (const auto& v : dae_.variables) nominal.push_back(v.declaration.nominal);
+    storeSection(b, 0, y0, [&](uint32_t j) { store(j, starts[j].y0, starts[j].source); });
+    storeSection(b, n, yp0, [&](uint32_t j) { store(n + j, starts[j].yp0, starts[j].derivativeSource); });
+    storeSection(b, 2 * n, nominal, [&](uint32_t j) {
       const auto& v = dae_.variables[j];
-      sym::Expr nominal = v.declaration.nominal;
-      store(2 * n + j, nominal, nominal ? addSource("nominal value of " + v.name, v.declaration.declRange) : UINT32_MAX);
-    }
+      store(2 * n + j, nominal[j], nominal[j] ? addSource("nominal value of " + v.name, v.declaration.declRange) : UINT32_MAX);
+    });
     reportUnbound(b, "start values", "a start value may use only literals, constants, parameters and time");
     m_.program(ModelProgram::InitialValues) = b.finish(3 * n);
+  }
+
+  // A run of at least kLoopRun slots whose values are numbers (null is 0), all equal or c_k =
+  // b·(k + 1) bit for bit (what `{b*i for i in 1:n}` flattens to): one loop stores it, with the
+  // same values. Shorter runs, and anything computed, are stored one by one (and keep their sources).
+  static constexpr size_t kLoopRun = 16;
+  struct NumberRun {
+    size_t begin, end;
+    double base;
+    bool proportional;  ///< value = base·(k + 1), k counted from `begin`; else `base`
+  };
+
+  static std::optional<double> numberOf(Expr e) {
+    if (!e) return 0.0;
+    return e->isConstant() ? std::optional<double>(e->value) : std::nullopt;
+  }
+  static bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+  static std::vector<NumberRun> numberRuns(const std::vector<Expr>& values) {
+    std::vector<NumberRun> runs;
+    for (size_t j = 0; j < values.size();) {
+      std::optional<double> first = numberOf(values[j]);
+      if (!first) {
+        ++j;
+        continue;
+      }
+      size_t equal = j + 1, proportional = j + 1;
+      while (equal < values.size() && numberOf(values[equal]) && sameBits(*numberOf(values[equal]), *first)) ++equal;
+      while (proportional < values.size() && numberOf(values[proportional]) &&
+             sameBits(*numberOf(values[proportional]), *first * static_cast<double>(proportional - j + 1)))
+        ++proportional;
+      size_t end = std::max(equal, proportional);
+      if (end - j >= kLoopRun) {
+        runs.push_back({j, end, *first, proportional > equal});
+        j = end;
+      } else {
+        ++j;
+      }
+    }
+    return runs;
+  }
+
+  static std::vector<char> inRuns(const std::vector<NumberRun>& runs, size_t n) {
+    std::vector<char> in(n, 0);
+    for (const NumberRun& r : runs) std::fill(in.begin() + static_cast<long>(r.begin), in.begin() + static_cast<long>(r.end), 1);
+    return in;
+  }
+
+  // Stores values[j] at slot0 + j: the runs by loops, the rest by storeOne(j), in order.
+  template <class StoreOne>
+  void storeSection(ProgramBuilder& b, uint32_t slot0, const std::vector<Expr>& values, StoreOne&& storeOne) {
+    size_t j = 0;
+    for (const NumberRun& r : numberRuns(values)) {
+      for (; j < r.begin; ++j) storeOne(static_cast<uint32_t>(j));
+      b.setSource(UINT32_MAX);
+      uint32_t base = b.constant(r.base), one = r.proportional ? b.constant(1.0) : 0;
+      b.beginLoop(Loop{.count = static_cast<uint32_t>(r.end - r.begin)});
+      uint32_t value = base;
+      if (r.proportional) value = b.emit(Op::Mul, base, b.emit(Op::Add, b.emit(Op::LoadLoopOffset), one));
+      b.storeLooped(slot0 + static_cast<uint32_t>(r.begin), value);
+      b.endLoop();
+      j = r.end;
+    }
+    for (; j < values.size(); ++j) storeOne(static_cast<uint32_t>(j));
   }
 
   // --- residual and Jacobian ---------------------------------------------------------------------

@@ -104,6 +104,30 @@ end Skip;
   EXPECT_GE(loops, 3u);  // interior regions split around the peeled x[5] and x[7], and the kinematic rows
 }
 
+// A large array's start values are loops (kernel/KernelBuilder.cpp, numberRuns) that store the very
+// numbers flattening folded: 0.01*i for x[i], 0 for every velocity, derivative and nominal.
+TEST(LoopedKernels, StartValuesOfALargeArrayAreLoopsWithTheSameBits) {
+  Compiled c(R"(model Chain
+  parameter Integer n = 50;
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+  coordinate Real y(start = 0.3);
+mechanics
+  kinetic = sum(0.5*der(x[i])^2 for i in 1:n) + 0.5*der(y)^2;
+  potential = sum(0.5*(x[i+1] - x[i])^2 for i in 1:n-1) + 0.5*(y - x[1])^2;
+end Chain;
+)", true);
+  const kernel::Program& init = c.kernels().program(ModelProgram::InitialValues);
+  EXPECT_GE(loopCount(init), 2u);
+  EXPECT_LT(init.code.size(), 40u);  // not 3 stores per unknown
+  size_t n = c.kernels().variableCount();
+  ASSERT_EQ(n, 102u);
+  std::vector<double> out(3 * n, -1.0);
+  kernel::interpret(init, ModelCall{}, out);
+  for (size_t i = 1; i <= 50; ++i) EXPECT_EQ(out[i - 1], 0.01 * static_cast<double>(i)) << "x[" << i << "]";
+  EXPECT_EQ(out[50], 0.3);
+  for (size_t j = n; j < 3 * n; ++j) EXPECT_EQ(out[j], 0.0) << j;
+}
+
 TEST(LoopedKernels, PendulumWithoutRepeatedStructureHasNoLoops) {
   EXPECT_EQ(expectSameKernels(R"(model Pendulum
   parameter Real m = 1, l = 1, g = 9.81;
