@@ -4,6 +4,7 @@
 #include "kernel/Jacobian.h"
 
 #include <algorithm>
+#include <optional>
 #include <unordered_map>
 
 #include "support/Assert.h"
@@ -77,18 +78,30 @@ size_t linear(const std::vector<int>& shape, std::span<const long> subscripts) {
   return k;
 }
 
-// The unknown of an array's first element; element k must be the unknown after it by k (the loops
-// address them so).
-std::pair<int, bool> consecutiveUnknowns(const flat::ArrayVariable& a,
-                                         const std::unordered_map<sym::Expr, std::pair<int, bool>>& unknownOf) {
-  auto it = unknownOf.find(a.elements[0]);
-  if (it == unknownOf.end()) QDOT_UNREACHABLE("a template reads an array that is not of unknowns");
-  for (size_t k = 0; k < a.elements.size(); ++k) {
-    auto e = unknownOf.find(a.elements[k]);
-    if (e == unknownOf.end() || e->second.first != it->second.first + static_cast<int>(k) || e->second.second != it->second.second)
-      QDOT_UNREACHABLE("a template reads an array whose elements are not consecutive unknowns");
+// Where relative symbol `rel` of `block` reads: the unknown of the array element with linear index
+// 0 (possibly not an element the block reads, or not an unknown at all: only an index base) and
+// whether it is y'. Every element the block reads — its region shifted by the pattern's offsets —
+// must be the unknown base + its linear index, of one kind: the loop addresses them so.
+std::pair<int, bool> unknownsRead(const dae::TemplateBlock& block, const flat::RelativeElement& rel,
+                                  const flat::ArrayVariable& a,
+                                  const std::unordered_map<sym::Expr, std::pair<int, bool>>& unknownOf) {
+  std::optional<std::pair<int, bool>> base;
+  std::vector<long> p;
+  for (auto [lo, hi] : block.region) p.push_back(lo);
+  for (size_t c = 0, n = block.pointCount(); c < n; ++c) {
+    long k = 0;
+    for (size_t d = 0; d < p.size(); ++d) k = k * a.shape[d] + (p[d] + rel.dims[d].offset - 1);
+    auto e = unknownOf.find(a.elements[static_cast<size_t>(k)]);
+    if (e == unknownOf.end()) QDOT_UNREACHABLE("a template reads an array element that is not an unknown");
+    std::pair<int, bool> at{e->second.first - static_cast<int>(k), e->second.second};
+    if (base && *base != at) QDOT_UNREACHABLE("a template reads array elements that are not consecutive unknowns");
+    base = at;
+    for (size_t d = p.size(); d-- > 0;) {
+      if (++p[d] <= block.region[d].second) break;
+      p[d] = block.region[d].first;
+    }
   }
-  return it->second;
+  return base.value_or(std::pair{0, false});
 }
 
 // The entries of block b: ∂F/∂y + cj ∂F/∂y' per column pattern, then one Entry per point.
@@ -177,17 +190,15 @@ std::vector<std::vector<TemplateOperand>> templateOperands(const dae::Dae& dae, 
     unknownOf.emplace(dae.variables[j].y, std::pair{j, false});
     if (dae.variables[j].yp) unknownOf.emplace(dae.variables[j].yp, std::pair{j, true});
   }
-  std::unordered_map<int, std::pair<int, bool>> checked;  // array → its first unknown, once verified
   for (size_t b = 0; b < out.size(); ++b) {
     const dae::TemplateBlock& block = dae.templateBlocks[b];
     for (sym::Expr s : ctx.freeSymbols(block.residual)) {
       const flat::RelativeElement* rel = dae.patterns->find(s);
       if (!rel) continue;
-      auto [known, first] = checked.try_emplace(rel->array);
-      if (first) known->second = consecutiveUnknowns(dae.patterns->arrays[rel->array], unknownOf);
+      auto [variable, derivative] = unknownsRead(block, *rel, dae.patterns->arrays[rel->array], unknownOf);
       long offset = 0;
       for (size_t d = 0; d < rel->dims.size(); ++d) offset = offset * block.shape[d] + rel->dims[d].offset;
-      out[b].push_back({s, known->second.first, known->second.second, offset});
+      out[b].push_back({s, variable, derivative, offset});
     }
   }
   return out;

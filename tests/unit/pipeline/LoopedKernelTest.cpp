@@ -104,6 +104,22 @@ end Skip;
   EXPECT_GE(loops, 3u);  // interior regions split around the peeled x[5] and x[7], and the kinematic rows
 }
 
+// Found by the fuzzer: the first mass has no kinetic energy (a first-order coordinate whose velocity
+// is algebraic), so the array of accelerations the interior's template reads is y' only from x[2] on.
+TEST(LoopedKernels, MasslessFirstElementGivesTheScalarResidualAndJacobian) {
+  size_t loops = expectSameKernels(R"(model Chain
+  parameter Integer n = 9;
+  parameter Real m = 1, k = 1000, c = 0.5;
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+mechanics
+  kinetic = sum(0.5*m*der(x[i])^2 for i in 2:n);
+  potential = 0.5*k*x[1]^2 + sum(0.5*k*(x[i+1] - x[i])^2 for i in 1:n-1);
+  dissipation = 0.5*c*der(x[1])^2 + sum(0.5*c*(der(x[i+1]) - der(x[i]))^2 for i in 1:n-1);
+end Chain;
+)");
+  EXPECT_GE(loops, 1u);
+}
+
 // A large array's start values are loops (kernel/KernelBuilder.cpp, numberRuns) that store the very
 // numbers flattening folded: 0.01*i for x[i], 0 for every velocity, derivative and nominal.
 TEST(LoopedKernels, StartValuesOfALargeArrayAreLoopsWithTheSameBits) {
