@@ -154,12 +154,17 @@ class Deriver {
       if (var < 0) continue;
       VarRole r = m_.variables[var].role;
       if (mayAppearInEnergy(r)) continue;
+      // The declaration to change: der(y[2]) is y's rate, y[2] an element of y.
+      const flat::Variable& shown = r == VarRole::Derivative && m_.variables[var].derivativeOf >= 0
+                                        ? m_.variables[m_.variables[var].derivativeOf]
+                                        : m_.variables[var];
+      std::string declared(shown.name.substr(0, shown.name.find('[')));
       diags_.error(t.range, DiagCode::E0402,
                    "this energy depends on '" + std::string(m_.variables[var].name) +
                        "', which is not a coordinate or its velocity",
                    r == VarRole::Acceleration
                        ? "energies cannot depend on accelerations"
-                       : "declare it as 'coordinate Real " + std::string(m_.variables[var].name) +
+                       : "declare '" + declared + "' as 'coordinate Real " + declared +
                              "', or express it through the coordinates with a definition");
     }
   }
