@@ -72,16 +72,10 @@ struct Invariant {
 struct TemplateBlock {
   int firstRow = -1;
   std::vector<int> shape;
-  std::vector<std::pair<long, long>> region;  ///< per dimension: first and last subscript
+  flat::Box region;  ///< per dimension: first and last subscript
   sym::Expr residual = nullptr;
   flat::OriginKind origin = flat::OriginKind::EulerLagrange;
   SourceRange range;  ///< the array's declaration
-
-  size_t pointCount() const {
-    size_t n = 1;
-    for (auto [lo, hi] : region) n *= static_cast<size_t>(hi - lo + 1);
-    return n;
-  }
 };
 
 struct Dae {

@@ -230,7 +230,7 @@ class Builder {
       }
       patterns.arrays.push_back(std::move(rates));
       flat::RelativeElement own{static_cast<int>(patterns.arrays.size()) - 1, {}};
-      std::vector<std::pair<long, long>> all;
+      flat::Box all;
       for (size_t d = 0; d < a.shape.size(); ++d) own.dims.push_back({static_cast<int>(d), 0}), all.push_back({1, a.shape[d]});
       flat::RelativeElement velocity = own;
       velocity.array = a.derivative;

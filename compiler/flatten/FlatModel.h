@@ -98,6 +98,39 @@ struct Output {
   OutputKind kind = OutputKind::Plain;
 };
 
+/// A box of subscripts or iterator values (issue 15): per dimension its first and last value,
+/// inclusive. Every template ranges over one; these are the only walks over them.
+using Box = std::vector<std::pair<long, long>>;
+
+/// The number of points of a box (0 if a dimension is empty).
+inline size_t pointCount(const Box& box) {
+  size_t n = 1;
+  for (auto [lo, hi] : box) n *= hi >= lo ? static_cast<size_t>(hi - lo + 1) : 0;
+  return n;
+}
+
+/// f(point) for every point of the box, row-major (the last dimension fastest), and f's count c
+/// (0, 1, …: the order of a loop over the box).
+template <class F>
+void forEachPoint(const Box& box, F&& f) {
+  if (pointCount(box) == 0) return;
+  std::vector<long> point;
+  for (auto [lo, hi] : box) point.push_back(lo);
+  for (size_t c = 0;; ++c) {
+    f(std::span<const long>(point), c);
+    size_t d = point.size();
+    while (d > 0 && ++point[d - 1] > box[d - 1].second) point[d - 1] = box[d - 1].first, --d;
+    if (d == 0) return;
+  }
+}
+
+/// The row-major index (0-based) of 1-based subscripts in an array of `shape`.
+inline long linearIndex(std::span<const int> shape, std::span<const long> subscripts) {
+  long k = 0;
+  for (size_t d = 0; d < shape.size(); ++d) k = k * shape[d] + (subscripts[d] - 1);
+  return k;
+}
+
 /// An array kept whole so that repeated structure stays repeated (issue 15, docs/loops.md): its
 /// elements, row-major, are still scalar expressions (a declared variable's are its variables'
 /// symbols). `derivative` is the array of the elements' der() (-1 until it is needed).
@@ -150,15 +183,9 @@ struct IndexedSum {
   enum class Energy : uint8_t { Kinetic, Potential, Dissipation };
   Energy energy = Energy::Kinetic;
   int term = -1;
-  std::vector<std::pair<long, long>> box;  ///< per iterator: first and last value (inclusive)
+  Box box;  ///< per iterator: first and last value
   sym::Expr body = nullptr;
   SourceRange range;  ///< the sum(...) call
-
-  size_t pointCount() const {
-    size_t n = 1;
-    for (auto [lo, hi] : box) n *= hi >= lo ? static_cast<size_t>(hi - lo + 1) : 0;
-    return n;
-  }
 };
 
 struct Experiment {

@@ -333,16 +333,8 @@ Expr instantiate(const FlatModel& model, sym::Context& ctx, Expr body, std::span
 void expandIndexedSums(FlatModel& model, sym::Context& ctx) {
   for (const IndexedSum& sum : model.indexedSums) {
     std::vector<Expr> parts;
-    parts.reserve(sum.pointCount());
-    std::vector<long> point;
-    for (auto [lo, hi] : sum.box) point.push_back(lo);
-    for (size_t n = sum.pointCount(); n > 0; --n) {
-      parts.push_back(instantiate(model, ctx, sum.body, point));
-      for (size_t d = point.size(); d-- > 0;) {  // row-major: the last iterator fastest
-        if (++point[d] <= sum.box[d].second) break;
-        point[d] = sum.box[d].first;
-      }
-    }
+    parts.reserve(pointCount(sum.box));
+    forEachPoint(sum.box, [&](std::span<const long> point, size_t) { parts.push_back(instantiate(model, ctx, sum.body, point)); });
     std::vector<Term>& terms = sum.energy == IndexedSum::Energy::Kinetic     ? model.kinetic
                                : sum.energy == IndexedSum::Energy::Potential ? model.potential
                                                                              : model.dissipation;

@@ -72,12 +72,6 @@ JacobianEntries compress(const std::vector<Entry>& entries, size_t columns, std:
   return J;
 }
 
-size_t linear(const std::vector<int>& shape, std::span<const long> subscripts) {
-  size_t k = 0;
-  for (size_t d = 0; d < shape.size(); ++d) k = k * shape[d] + static_cast<size_t>(subscripts[d] - 1);
-  return k;
-}
-
 // Where relative symbol `rel` of `block` reads: the unknown of the array element with linear index
 // 0 (possibly not an element the block reads, or not an unknown at all: only an index base) and
 // whether it is y'. Every element the block reads — its region shifted by the pattern's offsets —
@@ -86,9 +80,7 @@ std::pair<int, bool> unknownsRead(const dae::TemplateBlock& block, const flat::R
                                   const flat::ArrayVariable& a,
                                   const std::unordered_map<sym::Expr, std::pair<int, bool>>& unknownOf) {
   std::optional<std::pair<int, bool>> base;
-  std::vector<long> p;
-  for (auto [lo, hi] : block.region) p.push_back(lo);
-  for (size_t c = 0, n = block.pointCount(); c < n; ++c) {
+  flat::forEachPoint(block.region, [&](std::span<const long> p, size_t) {
     long k = 0;
     for (size_t d = 0; d < p.size(); ++d) k = k * a.shape[d] + (p[d] + rel.dims[d].offset - 1);
     auto e = unknownOf.find(a.elements[static_cast<size_t>(k)]);
@@ -96,11 +88,7 @@ std::pair<int, bool> unknownsRead(const dae::TemplateBlock& block, const flat::R
     std::pair<int, bool> at{e->second.first - static_cast<int>(k), e->second.second};
     if (base && *base != at) QDOT_UNREACHABLE("a template reads array elements that are not consecutive unknowns");
     base = at;
-    for (size_t d = p.size(); d-- > 0;) {
-      if (++p[d] <= block.region[d].second) break;
-      p[d] = block.region[d].first;
-    }
-  }
+  });
   return base.value_or(std::pair{0, false});
 }
 
@@ -118,20 +106,14 @@ void templateEntries(const dae::Dae& dae, sym::Context& ctx, sym::Expr cj, size_
     if (same != out.end()) same->value = ctx.add(same->value, d);
     else out.push_back({static_cast<int>(b), d, op.variable, op.offset, {}});
   }
-  size_t points = block.pointCount();
+  size_t points = flat::pointCount(block.region);
   for (size_t e = first; e < out.size(); ++e) out[e].positions.resize(points);
-  std::vector<long> p;
-  for (auto [lo, hi] : block.region) p.push_back(lo);
-  for (uint32_t c = 0; c < points; ++c) {
-    auto at = static_cast<long>(linear(block.shape, p));
+  flat::forEachPoint(block.region, [&](std::span<const long> p, size_t c) {
+    long at = flat::linearIndex(block.shape, p);
     for (size_t e = first; e < out.size(); ++e)
       entries.push_back({static_cast<int32_t>(block.firstRow + at), static_cast<int32_t>(out[e].variable + at + out[e].offset),
-                         nullptr, static_cast<int32_t>(e), c});
-    for (size_t d = p.size(); d-- > 0;) {
-      if (++p[d] <= block.region[d].second) break;
-      p[d] = block.region[d].first;
-    }
-  }
+                         nullptr, static_cast<int32_t>(e), static_cast<uint32_t>(c)});
+  });
 }
 
 }  // namespace

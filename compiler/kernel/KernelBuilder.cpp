@@ -477,7 +477,7 @@ class Builder {
     b.setSource(blockSource(k));
     std::vector<long> lo;
     for (auto [first, last] : block.region) lo.push_back(first);
-    long base = linearIndex(block.shape, lo);
+    long base = flat::linearIndex(block.shape, lo);
     const std::vector<Operand>& operands = jac.templateOperands[k];
     for (const auto& op : operands)
       b.bindLoopedLoad(op.symbol, op.derivative ? Op::LoadYpLooped : Op::LoadYLooped,
@@ -496,27 +496,15 @@ class Builder {
   // dimension, a table of offsets in more.
   static Loop loopOver(ProgramBuilder& b, const dae::TemplateBlock& block, long base) {
     Loop loop;
-    loop.count = static_cast<uint32_t>(block.pointCount());
+    loop.count = static_cast<uint32_t>(flat::pointCount(block.region));
     if (block.region.size() == 1) return loop;
     std::vector<uint32_t> offsets;
     offsets.reserve(loop.count);
-    std::vector<long> p;
-    for (auto [first, last] : block.region) p.push_back(first);
-    for (uint32_t c = 0; c < loop.count; ++c) {
-      offsets.push_back(static_cast<uint32_t>(linearIndex(block.shape, p) - base));
-      for (size_t d = p.size(); d-- > 0;) {
-        if (++p[d] <= block.region[d].second) break;
-        p[d] = block.region[d].first;
-      }
-    }
+    flat::forEachPoint(block.region, [&](std::span<const long> p, size_t) {
+      offsets.push_back(static_cast<uint32_t>(flat::linearIndex(block.shape, p) - base));
+    });
     loop.offsetTable = b.appendIndexTable(offsets);
     return loop;
-  }
-
-  static long linearIndex(const std::vector<int>& shape, const std::vector<long>& subscripts) {
-    long k = 0;
-    for (size_t d = 0; d < shape.size(); ++d) k = k * shape[d] + (subscripts[d] - 1);
-    return k;
   }
 
   // The temporaries whose values read no relative symbol, directly or through other temporaries

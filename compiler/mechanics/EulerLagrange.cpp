@@ -214,27 +214,12 @@ class Deriver {
                     : sum.energy == flat::IndexedSum::Energy::Potential ? potential
                                                                         : dissipation;
       std::vector<Expr> parts;
-      forEachPoint(sum.box, [&](std::span<const long> point) { parts.push_back(flat::instantiate(m_, ctx_, sum.body, point)); });
+      flat::forEachPoint(sum.box, [&](std::span<const long> point, size_t) { parts.push_back(flat::instantiate(m_, ctx_, sum.body, point)); });
       terms[sum.term].value = ctx_.add(terms[sum.term].value, ctx_.add(parts));
       scalarSums_.push_back(s);
     }
   }
   std::vector<int> scalarSums_;
-
-  template <class F>
-  static void forEachPoint(const std::vector<std::pair<long, long>>& box, F&& f) {
-    std::vector<long> point;
-    for (auto [lo, hi] : box) {
-      if (hi < lo) return;
-      point.push_back(lo);
-    }
-    while (true) {
-      f(std::span<const long>(point));
-      size_t d = point.size();
-      while (d > 0 && ++point[d - 1] > box[d - 1].second) point[d - 1] = box[d - 1].first, --d;
-      if (d == 0) return;
-    }
-  }
 
   // Coordinates that occur in scalar terms, forces or constraints keep scalar rows (peeled).
   std::vector<char> peeledCoordinates() const {
@@ -254,8 +239,8 @@ class Deriver {
     const auto& arrays = m_.patterns->arrays;
     for (int r = 0; r < static_cast<int>(t.rows.size()); ++r) {
       const auto& a = arrays[t.rows[r].array];
-      forEachPoint(t.rows[r].region, [&](std::span<const long> point) {
-        templateOf_[m_.variableOf(a.elements[linear(a.shape, point)])] = r;
+      flat::forEachPoint(t.rows[r].region, [&](std::span<const long> point, size_t) {
+        templateOf_[m_.variableOf(a.elements[flat::linearIndex(a.shape, point)])] = r;
       });
     }
     // Peeled elements and regions of one element: their contributions, instantiated.
@@ -265,8 +250,8 @@ class Deriver {
     std::vector<std::vector<Expr>> momentum(m_.variables.size()), position(m_.variables.size()), dissipation(m_.variables.size());
     for (const Contribution& c : t.contributions) {
       const auto& a = arrays[c.array];
-      forEachPoint(c.box, [&](std::span<const long> point) {
-        int q = m_.variableOf(a.elements[linear(a.shape, point)]);
+      flat::forEachPoint(c.box, [&](std::span<const long> point, size_t) {
+        int q = m_.variableOf(a.elements[flat::linearIndex(a.shape, point)]);
         if (templateOf_[q] >= 0) return;
         auto& into = c.part == Contribution::Part::Momentum ? momentum : c.part == Contribution::Part::Position ? position : dissipation;
         into[q].push_back(flat::instantiate(m_, ctx_, c.value, point));
@@ -278,12 +263,6 @@ class Deriver {
       if (!dissipation[q].empty()) extraDissipation_[q] = ctx_.add(dissipation[q]);
     }
     out_.templateRows = std::move(t.rows);
-  }
-
-  static size_t linear(const std::vector<int>& shape, std::span<const long> point) {
-    size_t k = 0;
-    for (size_t d = 0; d < shape.size(); ++d) k = k * shape[d] + static_cast<size_t>(point[d] - 1);
-    return k;
   }
 
   Expr plus(Expr a, Expr extra) { return extra ? ctx_.add(a, extra) : a; }

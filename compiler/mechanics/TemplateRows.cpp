@@ -14,7 +14,7 @@ using flat::RelativeElement;
 using flat::VarRole;
 using sym::Expr;
 
-using Box = std::vector<std::pair<long, long>>;
+using flat::Box;
 
 class TemplateDeriver {
  public:
@@ -176,7 +176,7 @@ class TemplateDeriver {
 
   void rowOn(int a, const Box& region) {
     TemplateRow row{a, region, nullptr, nullptr};
-    if (row.pointCount() < 2) return;  // one element: a scalar row
+    if (flat::pointCount(row.region) < 2) return;  // one element: a scalar row
     std::vector<Expr> momentum, position, dissipation;
     for (const Contribution& c : contributions_) {
       if (c.array != a || !contains(c.box, region)) continue;

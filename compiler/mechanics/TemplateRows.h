@@ -20,22 +20,16 @@ namespace qdot::mech {
 /// row's subscripts): relative symbols of the coordinates, their velocities and accelerations.
 struct TemplateRow {
   int array = -1;                             ///< ElementPatterns::arrays index (the coordinates)
-  std::vector<std::pair<long, long>> region;  ///< per dimension: first and last subscript
+  flat::Box region;                           ///< per dimension: first and last subscript
   sym::Expr residual = nullptr;               ///< d/dt(∂L/∂v) − ∂L/∂q + ∂D/∂v = 0
   sym::Expr momentum = nullptr;               ///< ∂L/∂v
-
-  size_t pointCount() const {
-    size_t n = 1;
-    for (auto [lo, hi] : region) n *= static_cast<size_t>(hi - lo + 1);
-    return n;
-  }
 };
 
 /// One summand of the rows of a coordinate array on a box of subscripts: the derivative of an
 /// IndexedSum's body by `x[%+o]` or `der(x)[%+o]`, shifted by −o (so %k is the row's subscript).
 struct Contribution {
   int array = -1;  ///< the coordinates
-  std::vector<std::pair<long, long>> box;
+  flat::Box box;
   enum class Part : uint8_t { Momentum, Position, Dissipation } part = Part::Position;  ///< ∂L/∂v, ∂L/∂q, ∂D/∂v
   sym::Expr value = nullptr;
 };

@@ -152,12 +152,8 @@ std::vector<mech::TemplateRow> expectRowsMatchScalarDerivation(const char* name,
   for (size_t i = 0; i < values.size(); ++i) values[i] = 0.3 + 0.7 * std::sin(1.0 + 1.7 * static_cast<double>(i));
   for (const mech::TemplateRow& row : t.rows) {
     const flat::ArrayVariable& a = f.templated->patterns->arrays[row.array];
-    std::vector<long> point;
-    for (auto [lo, hi] : row.region) point.push_back(lo);
-    for (size_t n = row.pointCount(); n > 0; --n) {
-      size_t flatIndex = 0;
-      for (size_t d = 0; d < point.size(); ++d) flatIndex = flatIndex * a.shape[d] + (point[d] - 1);
-      sym::Expr coordinate = a.elements[flatIndex];
+    flat::forEachPoint(row.region, [&](std::span<const long> point, size_t) {
+      sym::Expr coordinate = a.elements[static_cast<size_t>(flat::linearIndex(a.shape, point))];
       const mech::CoordinateRow* scalar = nullptr;
       for (const auto& r : eom->rows)
         if (f.scalar->variables[r.coordinate].symbol == coordinate) scalar = &r;
@@ -169,11 +165,7 @@ std::vector<mech::TemplateRow> expectRowsMatchScalarDerivation(const char* name,
         double expected = sym::evaluate(scalar->residual, values), got = sym::evaluate(instance, values);
         EXPECT_NEAR(got, expected, 1e-12 * (1 + std::abs(expected))) << s.ctx.symbolName(coordinate);
       }
-      for (size_t d = point.size(); d-- > 0;) {
-        if (++point[d] <= row.region[d].second) break;
-        point[d] = row.region[d].first;
-      }
-    }
+    });
   }
   // The whole derivation with templates: template rows where the regions are, the scalar rows of
   // the peeled elements (with the templates' contributions instantiated), each equal to the scalar one.
