@@ -160,7 +160,7 @@ Integrator::~Integrator() {
 // qdot's time scale for the velocities' automatic scales (runtime/arkode/StartLinearization.h), from
 // this program's own residual and Jacobian at the start values: the same rule, not qdot's numbers.
 rt::TimeScale Integrator::timeScale() const {
-  if (settings_.atol) return {};
+  if (settings_.atol || n_ > static_cast<sunindextype>(rt::kLargestWithFrequency)) return {};  // as qdot's
   std::vector<std::string> names = model_.variableNames();
   std::vector<const char*> pointers;
   for (const std::string& name : names) pointers.push_back(name.c_str());

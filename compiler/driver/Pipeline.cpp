@@ -10,6 +10,9 @@
 #include <chrono>
 #include <iostream>
 #include <iterator>
+#ifdef __GLIBC__
+#include <malloc.h>  // malloc_trim
+#endif
 
 #include "bodies/RigidBodies.h"
 #include "bytecode/Emitter.h"
@@ -81,6 +84,14 @@ bool templatesApply(const flat::FlatModel& m, const CompileOptions& o, const sym
   return plain;
 }
 
+// Gives the pages of freed blocks back to the system, so that what the solver allocates next
+// does not add to the compiler's peak (glibc keeps freed heap pages otherwise).
+void returnFreedMemory() {
+#ifdef __GLIBC__
+  malloc_trim(0);
+#endif
+}
+
 bool flatten(Compilation& c) {
   c.flat = timed(c.times.flatten, [&] {
     flat::FlattenLimits limits = c.options.limits;
@@ -112,14 +123,23 @@ bool buildDae(Compilation& c) {
     if (d && !dae::reduceIndex(*d, c.ctx, c.diags)) d.reset();
     return d;
   });
-  return c.dae && !c.diags.hasErrors();
+  if (c.dae) c.experiment = c.dae->experiment;
+  bool ok = c.dae && !c.diags.hasErrors();
+  if (ok && c.options.releaseStages) c.eom.reset(), c.flat.reset(), returnFreedMemory();
+  return ok;
 }
 
 bool buildKernels(Compilation& c) {
   c.kernels = timed(c.times.kernel, [&] {
     return std::make_shared<const kernel::KernelModule>(kernel::buildKernels(*c.dae, c.ctx, c.diags));
   });
-  return !c.diags.hasErrors();
+  bool ok = !c.diags.hasErrors();
+  if (ok && c.options.releaseStages) {  // the kernels hold no symbolic nodes
+    c.dae.reset();
+    c.ctx.clear();
+    returnFreedMemory();
+  }
+  return ok;
 }
 
 bool emitBytecode(Compilation& c) {

@@ -56,6 +56,11 @@ struct CompileOptions {
   /// Keep repeated structure as templates and loops where the model allows it (docs/loops.md):
   /// `qdot run`. Elsewhere (equations, modes, …) every sum is expanded.
   bool keepLoops = false;
+  /// Free each stage's input once the next stage has what it needs (`qdot run`: after the kernels
+  /// only the kernels, the bytecode and the experiment are used): the flat model and the
+  /// equations of motion once the DAE is built, the DAE and every symbolic node once the kernels
+  /// are. The compiler's peak memory is then that of one stage and its output, not of all stages.
+  bool releaseStages = false;
 };
 
 /// Everything one compilation creates; later stages point into earlier ones, so it is not
@@ -73,6 +78,7 @@ struct Compilation {
   std::optional<mech::EquationsOfMotion> eom;
   std::optional<dae::Dae> dae;
   dae::PruneReport pruned;  ///< what --outputs kept
+  flat::Experiment experiment;  ///< the DAE's experiment annotation (kept when the DAE is released)
   std::shared_ptr<const kernel::KernelModule> kernels;
   std::optional<bc::Module> bytecode;
   ModelPtr native;                ///< the JIT-compiled model (Stage::Native)

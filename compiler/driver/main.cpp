@@ -138,8 +138,8 @@ void printCompileStats(const driver::StageTimes& t, const driver::RunnableModel&
   if (m.waited) driver::printJitStats(m.jit->stats, std::cerr);
 }
 
-rt::ExperimentDefaults experimentOf(const dae::Dae& d) {
-  return {d.experiment.startTime, d.experiment.stopTime, d.experiment.interval, d.experiment.tolerance};
+rt::ExperimentDefaults experimentOf(const flat::Experiment& e) {
+  return {e.startTime, e.stopTime, e.interval, e.tolerance};
 }
 
 driver::Backend backendOf(const Options& o) {
@@ -152,6 +152,7 @@ ExitCode run(driver::Compilation& c, Options& o) {
   c.options.results = o.run.outputs;
   c.options.keepInvariants = o.run.invariants;
   c.options.keepLoops = true;
+  c.options.releaseStages = true;
   if (std::optional<ExitCode> failed = compileToKernels(c, o)) return *failed;
   driver::RunnableModel m = driver::makeRunnableModel(c, backendOf(o), o.run.invariants);
   if (!m.model) {
@@ -161,7 +162,7 @@ ExitCode run(driver::Compilation& c, Options& o) {
   if (!m.warning.empty()) std::cerr << "qdot: warning: " << m.warning << "\n";
   c.diags.render(std::cerr, c.sources, isatty(2));  // warnings, if any
   if (o.run.stats) printCompileStats(c.times, m);
-  ExitCode code = rt::runModel(*m.model, o.run, experimentOf(*c.dae), std::cout, std::cerr);
+  ExitCode code = rt::runModel(*m.model, o.run, experimentOf(c.experiment), std::cout, std::cerr);
   std::optional<rt::TierReport> tiers = driver::reportTiers(m, o.run.stats, std::cerr);
   if (tiers && tiers->compiling) {
     // The background compile owns what it reads, so destroying the model (cancel and join) is

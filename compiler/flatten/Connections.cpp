@@ -259,6 +259,7 @@ bool Flattener::overParameters(Expr e, bool timeToo) {
 // its constants (ValueKeys). An equation it rejects is reported (E0321) and stays an equation.
 void Flattener::eliminateAliases(const std::vector<std::vector<ConnectorEnd>>& sets, const std::vector<SourceRange>& ranges) {
   using structural::AliasRelation;
+  if (sets.empty() && aliasCandidates_.empty()) return;  // nothing to join (the cost is per variable)
   structural::AliasProblem problem;
   problem.numVariables = static_cast<int>(out_.variables.size());
   std::vector<char> touched(out_.variables.size(), 0);

@@ -142,6 +142,12 @@ Context::Context() : impl_(std::make_unique<Impl>(*this)) {
 
 Context::~Context() = default;
 
+void Context::clear() {
+  impl_ = std::make_unique<Impl>(*this);
+  zero_ = constant(0.0);
+  one_ = constant(1.0);
+}
+
 // Numbers recur constantly (0, 1, 2, -1, 0.5, model parameters): a direct-mapped cache in front
 // of the intern table answers most of them without hashing the node.
 Expr Context::constant(double v) {

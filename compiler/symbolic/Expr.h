@@ -84,6 +84,9 @@ class Context {
   ~Context();
   Context(const Context&) = delete;
   Context& operator=(const Context&) = delete;
+  /// Drops every node, symbol and memo: the Context is as new, and every Expr made before is
+  /// invalid. For a driver that has lowered everything it needs out of the symbolic form.
+  void clear();
 
   // --- leaves -----------------------------------------------------------------------------
   Expr constant(double v);

@@ -74,6 +74,7 @@ std::optional<double> lowestStartFrequency(std::span<const double> y0, const Den
 
 TimeScale modelTimeScale(const QdotModel& model, std::span<const double> p, double start) {
   TimeScale timeScale;
+  if (model.nVariables > kLargestWithFrequency) return timeScale;  // no frequency: nothing to pair up
   timeScale.positionOf = velocityPositions({model.variableNames, model.nVariables});
   bool hasVelocity = std::any_of(timeScale.positionOf.begin(), timeScale.positionOf.end(), [](int32_t q) { return q >= 0; });
   if (hasVelocity) timeScale.frequency = lowestStartFrequency(model, p, start).value_or(0.0);
