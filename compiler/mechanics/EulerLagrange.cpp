@@ -2,7 +2,10 @@
 #include "mechanics/EulerLagrange.h"
 
 #include <algorithm>
+#include <array>
+#include <map>
 #include <span>
+#include <unordered_map>
 
 #include "flatten/Flatten.h"
 #include <utility>
@@ -78,7 +81,9 @@ class Deriver {
   sym::Simplifier simplifier_;
   bool energiesSimplified_ = true;  ///< no energy ran out of the simplifier's budget
   TermIndex lagrangian_, dissipation_;
-  std::vector<std::vector<Expr>> forces_;  ///< by flat variable: the generalized forces on it
+  /// The generalized forces on each coordinate that has any (by flat variable: few of a large
+  /// model's variables have one, so not a vector over all of them).
+  std::unordered_map<int, std::vector<Expr>> forces_;
   EquationsOfMotion out_;
   std::optional<sym::DirectionalDerivative> timeDerivative_;  ///< d/dt, set up on first use
 
@@ -174,8 +179,12 @@ class Deriver {
       std::string name = "lambda[" + std::to_string(k + 1) + "]";
       out_.multipliers.push_back({name, ctx_.symbol(name), static_cast<int>(k)});
     }
-    forces_.resize(m_.variables.size());
     for (const auto& [q, term] : m_.forces) forces_[q].push_back(term.value);
+  }
+
+  std::span<const Expr> forcesOn(int q) const {
+    auto it = forces_.find(q);
+    return it == forces_.end() ? std::span<const Expr>() : std::span<const Expr>(it->second);
   }
 
   Expr partial(const TermIndex& idx, int var) {
@@ -187,22 +196,33 @@ class Deriver {
 
   // d/dt of an expression in coordinates, velocities, parameters and time: along q → v, v → a and
   // time → 1 (everything else is constant). One derivative object for all rows, so subexpressions
-  // the momenta share (the velocities of every mass) are differentiated once.
+  // the momenta share (the velocities of every mass) are differentiated once. The rates of e's
+  // symbols are given before e is differentiated (a derivative depends only on the rates of the
+  // symbols it contains), so a templated model's few scalar rows do not pay per element.
   Expr timeDerivative(Expr e) {
-    if (!timeDerivative_) {
-      timeDerivative_.emplace(ctx_);
-      for (const flat::Variable& v : m_.variables) {
-        if (v.role == VarRole::Time) timeDerivative_->setRate(v.symbol, ctx_.one());
-        else if ((v.role == VarRole::Coordinate || v.role == VarRole::Velocity) && v.derivative >= 0)
-          timeDerivative_->setRate(v.symbol, m_.variables[v.derivative].symbol);
-      }
+    if (!timeDerivative_) timeDerivative_.emplace(ctx_), rateGiven_.assign(ctx_.symbolCount(), 0);
+    for (Expr s : ctx_.freeSymbols(e)) {
+      if (s->symbolId >= rateGiven_.size()) rateGiven_.resize(s->symbolId + 1, 0);
+      if (rateGiven_[s->symbolId]) continue;
+      rateGiven_[s->symbolId] = 1;
+      int var = m_.variableOf(s);
+      if (var < 0) continue;
+      const flat::Variable& v = m_.variables[var];
+      if (v.role == VarRole::Time) timeDerivative_->setRate(v.symbol, ctx_.one());
+      else if ((v.role == VarRole::Coordinate || v.role == VarRole::Velocity) && v.derivative >= 0)
+        timeDerivative_->setRate(v.symbol, m_.variables[v.derivative].symbol);
     }
     return (*timeDerivative_)(e);
   }
+  std::vector<char> rateGiven_;  ///< by symbolId: its rate has been given to timeDerivative_
 
   // --- templates (issue 15, TemplateRows.h) ---
   std::vector<int> templateOf_;  ///< by flat variable: the template row of its element, or -1
-  std::vector<Expr> extraMomentum_, extraPosition_, extraDissipation_;  ///< by flat variable: peeled contributions
+  /// The templates' contributions to a peeled element's row, instantiated (by flat variable).
+  struct PeeledExtras {
+    Expr momentum = nullptr, position = nullptr, dissipation = nullptr;
+  };
+  std::unordered_map<int, PeeledExtras> extras_;
   bool templated_ = false;
 
   // Sums that cannot give template rows become the scalar terms flattening would have made.
@@ -227,7 +247,7 @@ class Deriver {
     for (int q : m_.variablesWithRole(VarRole::Coordinate)) {
       int v = m_.variables[q].derivative;
       peeled[q] = !lagrangian_.termsOf(q).empty() || !lagrangian_.termsOf(v).empty() || !dissipation_.termsOf(v).empty() ||
-                  !forces_[q].empty() || !m_.constraints.empty() || m_.variables[q].alias;
+                  !forcesOn(q).empty() || !m_.constraints.empty() || m_.variables[q].alias;
     }
     return peeled;
   }
@@ -244,24 +264,18 @@ class Deriver {
       });
     }
     // Peeled elements and regions of one element: their contributions, instantiated.
-    extraMomentum_.assign(m_.variables.size(), nullptr);
-    extraPosition_.assign(m_.variables.size(), nullptr);
-    extraDissipation_.assign(m_.variables.size(), nullptr);
-    std::vector<std::vector<Expr>> momentum(m_.variables.size()), position(m_.variables.size()), dissipation(m_.variables.size());
+    std::map<int, std::array<std::vector<Expr>, 3>> parts;  // by flat variable: momentum, position, dissipation
     for (const Contribution& c : t.contributions) {
       const auto& a = arrays[c.array];
       flat::forEachPoint(c.box, [&](std::span<const long> point, size_t) {
         int q = m_.variableOf(a.elements[flat::linearIndex(a.shape, point)]);
         if (templateOf_[q] >= 0) return;
-        auto& into = c.part == Contribution::Part::Momentum ? momentum : c.part == Contribution::Part::Position ? position : dissipation;
-        into[q].push_back(flat::instantiate(m_, ctx_, c.value, point));
+        int part = c.part == Contribution::Part::Momentum ? 0 : c.part == Contribution::Part::Position ? 1 : 2;
+        parts[q][part].push_back(flat::instantiate(m_, ctx_, c.value, point));
       });
     }
-    for (size_t q = 0; q < m_.variables.size(); ++q) {
-      if (!momentum[q].empty()) extraMomentum_[q] = ctx_.add(momentum[q]);
-      if (!position[q].empty()) extraPosition_[q] = ctx_.add(position[q]);
-      if (!dissipation[q].empty()) extraDissipation_[q] = ctx_.add(dissipation[q]);
-    }
+    auto sum = [&](const std::vector<Expr>& terms) { return terms.empty() ? nullptr : ctx_.add(terms); };
+    for (const auto& [q, p] : parts) extras_[q] = {sum(p[0]), sum(p[1]), sum(p[2])};
     out_.templateRows = std::move(t.rows);
   }
 
@@ -274,11 +288,13 @@ class Deriver {
       out_.rows.push_back({q, nullptr, nullptr, true, templateOf_[q]});
       return;
     }
-    bool extra = templated_ && (extraMomentum_[q] || extraPosition_[q] || extraDissipation_[q]);
-    Expr p = templated_ ? plus(partial(lagrangian_, v), extraMomentum_[q]) : partial(lagrangian_, v);
-    std::vector<Expr> parts{timeDerivative(p), ctx_.neg(templated_ ? plus(partial(lagrangian_, q), extraPosition_[q]) : partial(lagrangian_, q)),
-                            templated_ ? plus(partial(dissipation_, v), extraDissipation_[q]) : partial(dissipation_, v)};
-    for (Expr f : forces_[q]) parts.push_back(ctx_.neg(f));
+    auto found = extras_.find(q);
+    PeeledExtras none, &extras = found == extras_.end() ? none : found->second;
+    bool extra = extras.momentum || extras.position || extras.dissipation;
+    Expr p = plus(partial(lagrangian_, v), extras.momentum);
+    std::vector<Expr> parts{timeDerivative(p), ctx_.neg(plus(partial(lagrangian_, q), extras.position)),
+                            plus(partial(dissipation_, v), extras.dissipation)};
+    for (Expr f : forcesOn(q)) parts.push_back(ctx_.neg(f));
     bool constrained = false;
     for (const auto& mult : out_.multipliers) {
       Expr dg = ctx_.diff(m_.constraints[mult.constraint].residual, coord.symbol);
@@ -286,13 +302,13 @@ class Deriver {
       parts.push_back(ctx_.neg(ctx_.mul(mult.symbol, dg)));
     }
     Expr residual = ctx_.add(parts);
-    if (lagrangian_.termsOf(q).empty() && lagrangian_.termsOf(v).empty() && forces_[q].empty() && !constrained && !extra) {
+    if (lagrangian_.termsOf(q).empty() && lagrangian_.termsOf(v).empty() && forcesOn(q).empty() && !constrained && !extra) {
       diags_.error(coord.declRange, DiagCode::E0401,
                    "coordinate '" + std::string(coord.name) + "' appears in no energy, force or constraint",
                    "add its kinetic energy in the mechanics section, or declare it as a plain 'Real'");
       return;
     }
-    bool inertial = !lagrangian_.termsOf(v).empty() || (extra && extraMomentum_[q]);
+    bool inertial = !lagrangian_.termsOf(v).empty() || extras.momentum;
     out_.rows.push_back({q, simplified(residual), simplified(p), inertial});
   }
 
@@ -311,7 +327,7 @@ class Deriver {
       int v = coord.derivative;
       if (conservative) jacobi.push_back(ctx_.mul(m_.variables[v].symbol, row.momentum));
       bool cyclic = !m_.variables[row.coordinate].alias && lagrangian_.termsOf(row.coordinate).empty() &&
-                    forces_[row.coordinate].empty() &&
+                    forcesOn(row.coordinate).empty() &&
                     dissipation_.termsOf(v).empty() && !row.momentum->isZero();
       for (const auto& c : m_.constraints) cyclic &= !ctx_.dependsOn(c.residual, coord.symbol);
       if (cyclic)
