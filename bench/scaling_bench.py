@@ -79,6 +79,32 @@ def whole(build, n, stop, repeat):
     return {"n": n, "qwall": best["qdot"][0], "qpeak": best["qdot"][1], "hwall": best["hand"][0], "hpeak": best["hand"][1]}
 
 
+SMALL = [("N-link pendulum n = 8", "examples/pendulum/nlink.qd", ["-p", "n=8"]),
+         ("double pendulum", "examples/pendulum/double_pendulum.qd", []),
+         ("spring chain n = 10", CHAIN, [])]
+
+
+def small_models(build, repeat):
+    """Small models stay small: file -> first step on the VM (`--backend bytecode`, horizon 1e-4 s),
+    best of `repeat` fresh processes, with the compile time --stats reports."""
+    rows = []
+    for name, path, extra in SMALL:
+        command = [f"{build}/qdot", "run", path, *extra, "--stop", "1e-4", "--interval", "1e-4", "--backend", "bytecode",
+                   "-o", "/dev/null", "--stats", "--no-progress"]
+        best_wall, best_inside = float("inf"), float("inf")
+        for _ in range(repeat):
+            wall, _, err = peak_of(command)
+            best_wall = min(best_wall, wall)
+            inside = number(r"; total ([0-9.e+-]+)", err) / 1e3 + number(r"setup ([0-9.e+-]+) s", err)
+            best_inside = min(best_inside, inside)
+        rows.append((name, best_wall, best_inside))
+    print(f"\n## Small models: file to first step on the VM (best of {repeat} processes)\n")
+    print("| model | **file → first step**: compile + IDA setup (--stats) [ms] | whole process to t = 1e-4 s, with the process start [ms] |")
+    print("| --- | ---: | ---: |")
+    for name, wall, inside in rows:
+        print(f"| {name} | {inside * 1e3:.2f} | {wall * 1e3:.1f} |")
+
+
 def print_whole(rows, stop, repeat):
     print(f"\n## Whole process, issue 15's setting (rtol 1e-6, {stop:g} s, KLU, columns x[1], x[n]; "
           f"default mode; best of {repeat})\n")
@@ -126,6 +152,7 @@ def main():
         print("|---|" + "---:|" * len(cols))
         for x, y in zip(rows, rows[1:]):
             print(f"| {x['n']} → {y['n']} | " + " | ".join(f"{exponent(x, y, c):.2f}" for c in cols) + " |")
+    small_models(a.build, 10)
     if a.whole_sizes != "none":
         whole_sizes = [int(s) for s in a.whole_sizes.split(",")] if a.whole_sizes else (
             [1000, 10000] if a.quick else [1000, 10000, 100000])
