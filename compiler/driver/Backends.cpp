@@ -71,7 +71,7 @@ void addBackgroundJit(const Compilation& c, rt::TierTrigger trigger, RunnableMod
       [kernels = c.kernels, sources, options, jit = out.jit](const std::atomic<bool>& cancel) {
         llvmbackend::JitOptions withCancel = options;
         withCancel.cancel = &cancel;
-        Result<ModelPtr> model = llvmbackend::createJitModel(*kernels, *sources, withCancel, &jit->stats);
+        Result<ModelPtr> model = llvmbackend::createJitModel(kernels, *sources, withCancel, &jit->stats);
         if (!model) jit->error = model.error();
         return model ? std::move(model).value() : ModelPtr();
       },
