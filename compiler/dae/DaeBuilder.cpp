@@ -2,6 +2,7 @@
 // adds the kinematic rows q' = der(q), and checks the balance of equations and unknowns.
 #include "dae/Dae.h"
 #include "dae/Balance.h"
+#include "dae/TemplateOde.h"
 #include "support/Assert.h"
 
 #include <algorithm>
@@ -27,6 +28,11 @@ class Builder {
     dae_.structuralParameters = m_.structuralParameters;
     dae_.unconnected = m_.unconnected;
     dae_.outputs = m_.outputs;
+    if (!m_.equationTemplates.empty()) {  // an explicit ODE (isTemplatedOde): balanced by construction
+      addParameters();
+      addTemplatedOde(m_, ctx_, dae_);
+      return std::move(dae_);
+    }
     collectAliases();
     addParameters();
     addEquations();
