@@ -192,7 +192,7 @@ bool emitBytecode(Compilation& c) {
 // A JIT failure is not an error in the model: c.internalError says what failed.
 bool compileNative(Compilation& c) {
   Result<ModelPtr> model =
-      timed(c.times.native, [&] { return llvmbackend::createJitModel(*c.kernels, c.sources, c.options.jit, &c.jitStats); });
+      timed(c.times.native, [&] { return llvmbackend::createJitModel(c.kernels, c.sources, c.options.jit, &c.jitStats); });
   if (!model) {
     c.internalError = "the LLVM JIT failed: " + model.error();
     return false;
