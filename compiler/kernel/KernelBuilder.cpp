@@ -74,6 +74,9 @@ class Builder {
   void describeModel() {
     ModelDescription& d = m_.description;
     d.name = dae_.name;
+    d.variableNames.reserve(dae_.variables.size());
+    d.isDifferential.reserve(dae_.variables.size());
+    d.fixed.reserve(dae_.variables.size());
     for (const auto& v : dae_.variables) {
       d.variableNames.push_back(v.name);
       d.isDifferential.push_back(v.kind == dae::VarKind::State);
@@ -151,12 +154,15 @@ class Builder {
     if (dae_.time) b.bindLoad(dae_.time, Op::LoadTime, 0);
     for (uint32_t k = 0; k < dae_.parameters.size(); ++k) b.bindLoad(dae_.parameters[k].symbol, Op::LoadP, k);
     if (cj) b.bindLoad(cj, Op::LoadCj, 0);
-    if (!variables) return;
-    for (uint32_t j = 0; j < dae_.variables.size(); ++j) {
-      b.bindLoad(dae_.variables[j].y, Op::LoadY, j);
-      if (dae_.variables[j].yp) b.bindLoad(dae_.variables[j].yp, Op::LoadYp, j);
-    }
+    if (variables) b.bindUnknowns(unknowns());
   }
+
+  // The DAE's y and y' by symbol, built on first use and shared by every program and the Jacobian.
+  const UnknownSymbols& unknowns() {
+    if (!unknowns_) unknowns_.emplace(dae_);
+    return *unknowns_;
+  }
+  std::optional<UnknownSymbols> unknowns_;
 
   // A symbol no input binds: at the source that used it (the model's line if that has no location).
   void reportUnbound(const ProgramBuilder& b, const std::string& where, const char* help) {
@@ -418,11 +424,13 @@ class Builder {
 
   void buildResidualAndJacobian() {
     Expr cj = ctx_.symbol("$cj");
-    JacobianEntries jac = initialRows_.empty() ? differentiate(dae_, ctx_, cj) : differentiate(withInitialRows(), ctx_, cj);
-    m_.description.jacobianColumnStarts = jac.columnStarts;
-    m_.description.jacobianRowIndices = jac.rowIndices;
+    JacobianEntries jac = initialRows_.empty() ? differentiate(dae_, unknowns(), ctx_, cj)
+                                                : differentiate(withInitialRows(), unknowns(), ctx_, cj);
+    auto nonzeros = static_cast<uint32_t>(jac.rowIndices.size());
+    m_.description.jacobianColumnStarts = std::move(jac.columnStarts);
+    m_.description.jacobianRowIndices = std::move(jac.rowIndices);
     std::vector<Expr> roots;
-    std::vector<uint32_t> rows, entries;  // the rows and Jacobian entries the roots are (template ones are not)
+    std::vector<uint32_t> rows;  // the rows the roots are (template ones are not)
     for (uint32_t i = 0; i < dae_.equations.size(); ++i)
       if (dae_.equations[i].residual) roots.push_back(dae_.equations[i].residual), rows.push_back(i);
     for (size_t k = 0; k < initialRows_.size(); ++k) {  // after every DAE row: rows used only at t0
@@ -434,8 +442,7 @@ class Builder {
       roots.push_back(e.residual), rows.push_back(static_cast<uint32_t>(row));
     }
     size_t rowRoots = roots.size();
-    for (uint32_t k = 0; k < jac.values.size(); ++k)
-      if (jac.values[k]) roots.push_back(jac.values[k]), entries.push_back(k);
+    for (const ScalarEntry& e : jac.scalarEntries) roots.push_back(e.value);
     roots = sym::expandAngleDifferences(ctx_, roots);  // sin/cos of each angle once, shared
     sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, roots, "$t");
     m_.sharedTemporaries = cse.temporaries.size();
@@ -452,12 +459,13 @@ class Builder {
     ProgramBuilder jb(programName(ModelProgram::Jacobian));
     bindInputs(jb, true, cj);
     for (const auto& [t, value] : cse.temporaries) jb.bindTemporary(t, value);
-    for (size_t k = 0; k < entries.size(); ++k) {
-      jb.setSource(equationSource_[jac.rowIndices[entries[k]]]);
-      jb.store(entries[k], jb.lower(cse.outputs[rowRoots + k]));
+    for (size_t k = 0; k < jac.scalarEntries.size(); ++k) {
+      const ScalarEntry& e = jac.scalarEntries[k];
+      jb.setSource(equationSource_[e.row]);
+      jb.store(e.position, jb.lower(cse.outputs[rowRoots + k]));
     }
     for (size_t b = 0; b < dae_.templateBlocks.size(); ++b) emitBlock(jb, b, jac, true);
-    m_.program(ModelProgram::Jacobian) = jb.finish(static_cast<uint32_t>(jac.values.size()));
+    m_.program(ModelProgram::Jacobian) = jb.finish(nonzeros);
   }
 
   // --- template blocks (issue 15, docs/loops.md) ---------------------------------------------------
