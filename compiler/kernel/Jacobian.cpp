@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <optional>
 
+#include "kernel/SymbolSlots.h"
 #include "support/Assert.h"
 #include "symbolic/NodeMap.h"
 
@@ -58,17 +59,16 @@ struct RowEntry {
 std::vector<RowEntry> scalarEntries(const dae::Dae& dae, sym::Context& ctx, sym::Expr cj,
                                        const UnknownSymbols& unknowns) {
   std::vector<sym::Expr> symbols = scalarUnknowns(dae, unknowns);
-  std::vector<int32_t> variableOf;   // by position in symbols
-  std::vector<uint32_t> positionOf;  // by symbolId
+  std::vector<int32_t> variableOf;  // by position in symbols
+  SymbolSlots<uint32_t> positionOf(kNone);
   for (sym::Expr s : symbols) {
-    if (positionOf.size() <= s->symbolId) positionOf.resize(s->symbolId + 1, kNone);
-    positionOf[s->symbolId] = static_cast<uint32_t>(variableOf.size());
+    positionOf.at(s->symbolId) = static_cast<uint32_t>(variableOf.size());
     variableOf.push_back(static_cast<int32_t>(unknowns.find(s)->variable));
   }
   sym::PartialDerivatives partial(ctx, symbols);
   std::vector<sym::Expr> byPosition(symbols.size(), ctx.zero());  // the row's gradient
   auto derivative = [&](sym::Expr s) {
-    uint32_t k = s->symbolId < positionOf.size() ? positionOf[s->symbolId] : kNone;
+    uint32_t k = positionOf.get(s->symbolId);
     return k == kNone ? ctx.zero() : byPosition[k];
   };
   sym::NodeMap<sym::Expr> timesCj;  // dF/dy' -> cj*dF/dy' (few distinct ones in a regular model)

@@ -240,9 +240,9 @@ class Builder {
   std::vector<dae::StartUse> startUse_;                   ///< per variable: what its start value is
   std::vector<dae::Equation> initialRows_;                ///< initial equations that are not start values
 
-  struct Start {
-    Expr y0 = nullptr, yp0 = nullptr;
-    uint32_t source = UINT32_MAX, derivativeSource = UINT32_MAX;
+  struct Starts {
+    std::vector<Expr> values;       ///< per variable: y0 (null: 0)
+    std::vector<uint32_t> sources;  ///< per variable: the source of its value (UINT32_MAX: none)
   };
 
   bool overParameters(Expr e) const {
@@ -255,7 +255,7 @@ class Builder {
   }
 
   // `v = expr` or `der(x) = expr` (either side) with expr over parameters and time.
-  bool applyInitialEquation(size_t i, std::vector<Start>& starts) {
+  bool applyInitialEquation(size_t i, Starts& starts) {
     const dae::Equation& e = dae_.initialEquations[i];
     if (!e.lhs || !e.rhs) return false;
     for (int side = 0; side < 2; ++side) {
@@ -266,7 +266,7 @@ class Builder {
         if (v.y != target) continue;  // a derivative's value is a condition of the initialization system
         if (!acceptInitialEquation(e, i, j, true)) return true;  // reported
         uint32_t src = addSource("initial equation " + std::to_string(i + 1), e.origin.range, equationText(e));
-        starts[j].y0 = value, starts[j].source = src, m_.description.fixed[j] = kFixedAsWritten;
+        starts.values[j] = value, starts.sources[j] = src, m_.description.fixed[j] = kFixedAsWritten;
         startUse_[j] = dae::StartUse::Required;
         return true;
       }
@@ -298,23 +298,24 @@ class Builder {
     return true;
   }
 
-  std::vector<Start> collectStarts() {
-    std::vector<Start> starts(dae_.variables.size());
-    std::vector<Expr> declared;
-    for (const auto& v : dae_.variables) declared.push_back(v.declaration.start);
-    std::vector<char> looped = inRuns(numberRuns(declared), declared.size());
-    for (size_t j = 0; j < dae_.variables.size(); ++j) {
-      const auto& v = dae_.variables[j];
-      starts[j].y0 = v.declaration.start;
-      if (v.declaration.start && !looped[j]) starts[j].source = addSource("start value of " + v.name, v.declaration.declRange);
-    }
-    startUse_.resize(dae_.variables.size());
-    for (size_t j = 0; j < dae_.variables.size(); ++j) {  // as written (fixed = …), else the default
+  // One pass over the variables (a large model has millions): declared starts and their use.
+  Starts collectStarts() {
+    size_t n = dae_.variables.size();
+    Starts starts;
+    starts.values.reserve(n);
+    startUse_.reserve(n);
+    for (size_t j = 0; j < n; ++j) {
       const flat::Variable& d = dae_.variables[j].declaration;
-      startUse_[j] = d.fixedGiven ? (d.fixed ? dae::StartUse::Required : dae::StartUse::Guess)
-                     : m_.description.fixed[j] ? dae::StartUse::Default
-                                               : dae::StartUse::Guess;
+      starts.values.push_back(d.start);
+      startUse_.push_back(d.fixedGiven ? (d.fixed ? dae::StartUse::Required : dae::StartUse::Guess)  // as written
+                          : m_.description.fixed[j] ? dae::StartUse::Default
+                                                    : dae::StartUse::Guess);
     }
+    starts.sources.assign(n, UINT32_MAX);
+    std::vector<char> looped = inRuns(numberRuns(starts.values), n);
+    for (size_t j = 0; j < n; ++j)
+      if (starts.values[j] && !looped[j])
+        starts.sources[j] = addSource("start value of " + dae_.variables[j].name, dae_.variables[j].declaration.declRange);
     for (size_t i = 0; i < dae_.initialEquations.size(); ++i)
       if (!applyInitialEquation(i, starts)) initialRows_.push_back(dae_.initialEquations[i]);
     if (!initialRows_.empty()) planInitialRows();
@@ -335,7 +336,7 @@ class Builder {
   // out = [y0 (n), yp0 (n), nominal (n)]; stores of a plain 0 serve no source. Runs of numbers
   // (a large array's starts, its zero derivatives and nominals) are stored by loops.
   void buildInitialValues() {
-    std::vector<Start> starts = collectStarts();
+    Starts starts = collectStarts();
     ProgramBuilder b(programName(ModelProgram::InitialValues));
     bindInputs(b, false);
     auto n = static_cast<uint32_t>(dae_.variables.size());
@@ -343,11 +344,11 @@ class Builder {
       b.setSource(value ? source : UINT32_MAX);
       b.store(slot, value ? b.lower(value) : b.constant(0.0));
     };
-    std::vector<Expr> y0, yp0, nominal;
-    for (const Start& st : starts) y0.push_back(st.y0), yp0.push_back(st.yp0);
+    std::vector<Expr> derivatives(n, nullptr), nominal;  // y'0 = 0: no start value gives one
+    nominal.reserve(n);
     for (const auto& v : dae_.variables) nominal.push_back(v.declaration.nominal);
-    storeSection(b, 0, y0, [&](uint32_t j) { store(j, starts[j].y0, starts[j].source); });
-    storeSection(b, n, yp0, [&](uint32_t j) { store(n + j, starts[j].yp0, starts[j].derivativeSource); });
+    storeSection(b, 0, starts.values, [&](uint32_t j) { store(j, starts.values[j], starts.sources[j]); });
+    storeSection(b, n, derivatives, [&](uint32_t j) { store(n + j, nullptr, UINT32_MAX); });
     storeSection(b, 2 * n, nominal, [&](uint32_t j) {
       const auto& v = dae_.variables[j];
       store(2 * n + j, nominal[j], nominal[j] ? addSource("nominal value of " + v.name, v.declaration.declRange) : UINT32_MAX);
