@@ -20,7 +20,7 @@ constexpr uint32_t kNone = UINT32_MAX;
 // The distinct unknowns the scalar rows read, for sym::PartialDerivatives: every y and y' when no
 // template serves rows (each is read somewhere), else those found in one walk of the scalar rows
 // (a few boundary rows next to millions of template elements).
-std::vector<sym::Expr> scalarUnknowns(const dae::Dae& dae, const UnknownSymbols& unknowns) {
+std::vector<sym::Expr> scalarUnknowns(const dae::Dae& dae, std::span<const int32_t> rows, const UnknownSymbols& unknowns) {
   std::vector<sym::Expr> out;
   sym::NodeSet seen;
   auto visit = [&](sym::Expr s) {
@@ -37,8 +37,7 @@ std::vector<sym::Expr> scalarUnknowns(const dae::Dae& dae, const UnknownSymbols&
   auto push = [&](sym::Expr e) {
     if (e->symbolMask && seen.insert(e)) stack.push_back(e);
   };
-  for (const dae::Equation& e : dae.equations)
-    if (e.residual) push(e.residual);
+  for (int32_t i : rows) push(dae.equations[i].residual);
   while (!stack.empty()) {
     sym::Expr n = stack.back();
     stack.pop_back();
@@ -56,9 +55,11 @@ struct RowEntry {
 };
 
 // The entries of the scalar rows, in row order.
-std::vector<RowEntry> scalarEntries(const dae::Dae& dae, sym::Context& ctx, sym::Expr cj,
-                                       const UnknownSymbols& unknowns) {
-  std::vector<sym::Expr> symbols = scalarUnknowns(dae, unknowns);
+std::vector<RowEntry> scalarEntries(const dae::Dae& dae, sym::Context& ctx, sym::Expr cj, const UnknownSymbols& unknowns) {
+  std::vector<int32_t> rows;  // those with a residual of their own (not a template block's)
+  for (size_t i = 0; i < dae.equations.size(); ++i)
+    if (dae.equations[i].residual) rows.push_back(static_cast<int32_t>(i));
+  std::vector<sym::Expr> symbols = scalarUnknowns(dae, rows, unknowns);
   std::vector<int32_t> variableOf;  // by position in symbols
   SymbolSlots<uint32_t> positionOf(kNone);
   for (sym::Expr s : symbols) {
@@ -81,9 +82,8 @@ std::vector<RowEntry> scalarEntries(const dae::Dae& dae, sym::Context& ctx, sym:
   std::vector<RowEntry> entries;
   std::vector<int32_t> candidates;
   std::vector<char> seen(dae.variables.size(), 0);
-  for (size_t i = 0; i < dae.equations.size(); ++i) {
+  for (int32_t i : rows) {
     sym::Expr f = dae.equations[i].residual;
-    if (!f) continue;  // a template block's row
     std::span<const sym::Expr> gradient = partial.gradient(f);
     std::span<const uint32_t> listed = partial.symbolsIn(f);
     candidates.clear();
@@ -97,7 +97,7 @@ std::vector<RowEntry> scalarEntries(const dae::Dae& dae, sym::Context& ctx, sym:
       const dae::Variable& v = dae.variables[j];
       sym::Expr d = derivative(v.y), dyp = v.yp ? derivative(v.yp) : ctx.zero();
       if (dyp != ctx.zero()) d = ctx.add(d, cjTimes(dyp));  // d + cj*0 is d
-      if (!d->isZero()) entries.push_back({static_cast<int32_t>(i), j, d});
+      if (!d->isZero()) entries.push_back({i, j, d});
     }
     for (uint32_t k : listed) byPosition[k] = ctx.zero();
   }

@@ -47,6 +47,7 @@ class Builder {
   DiagnosticEngine& diags_;
   KernelModule m_;
   std::vector<uint32_t> equationSource_;
+  std::vector<uint32_t> scalarRows_;  ///< the DAE's rows with a residual of their own (not a template block's)
 
   uint32_t addSource(std::string label, SourceRange range, std::string text = {}) {
     m_.sources.push_back({std::move(label), range, shorten(std::move(text))});
@@ -146,6 +147,7 @@ class Builder {
     for (size_t i = 0; i < dae_.equations.size(); ++i) {
       const auto& e = dae_.equations[i];
       equationSource_.push_back(e.residual ? addSource(equationLabel(i, e), e.origin.range, equationText(e)) : UINT32_MAX);
+      if (e.residual) scalarRows_.push_back(static_cast<uint32_t>(i));
     }
   }
 
@@ -432,8 +434,7 @@ class Builder {
     m_.description.jacobianRowIndices = std::move(jac.rowIndices);
     std::vector<Expr> roots;
     std::vector<uint32_t> rows;  // the rows the roots are (template ones are not)
-    for (uint32_t i = 0; i < dae_.equations.size(); ++i)
-      if (dae_.equations[i].residual) roots.push_back(dae_.equations[i].residual), rows.push_back(i);
+    for (uint32_t i : scalarRows_) roots.push_back(dae_.equations[i].residual), rows.push_back(i);
     for (size_t k = 0; k < initialRows_.size(); ++k) {  // after every DAE row: rows used only at t0
       const auto& e = initialRows_[k];
       auto row = static_cast<int32_t>(dae_.equations.size() + k);
@@ -465,21 +466,34 @@ class Builder {
       jb.setSource(equationSource_[e.row]);
       jb.store(e.position, jb.lower(cse.outputs[rowRoots + k]));
     }
+    jb.reserveIndexTable(jacobianIndexTableSize(jac));
     for (size_t b = 0; b < dae_.templateBlocks.size(); ++b) emitBlock(jb, b, jac, true);
     m_.program(ModelProgram::Jacobian) = jb.finish(nonzeros);
+  }
+
+  // What the Jacobian's blocks append to its index table: every template entry's CSC positions
+  // and the offsets of each block that loops over a table (more than one dimension).
+  size_t jacobianIndexTableSize(const JacobianEntries& jac) const {
+    size_t n = 0;
+    std::vector<char> hasEntries(dae_.templateBlocks.size(), 0);
+    for (const TemplateEntry& e : jac.templateEntries) n += e.positions.size(), hasEntries[e.block] = 1;
+    for (size_t b = 0; b < hasEntries.size(); ++b)
+      if (hasEntries[b] && dae_.templateBlocks[b].region.size() > 1) n += flat::pointCount(dae_.templateBlocks[b].region);
+    return n;
   }
 
   // --- template blocks (issue 15, docs/loops.md) ---------------------------------------------------
 
   // One loop over block b's region: its rows (residual) or its Jacobian entries, each stored at its
   // CSC position through an index table. The block's own CSE; temporaries that read no relative
-  // symbol (parameters only) are computed once before the loop.
-  void emitBlock(ProgramBuilder& b, size_t k, const JacobianEntries& jac, bool jacobian) {
+  // symbol (parameters only) are computed once before the loop. The entries' positions move to the
+  // program's index table (freed here: a large model has millions).
+  void emitBlock(ProgramBuilder& b, size_t k, JacobianEntries& jac, bool jacobian) {
     const dae::TemplateBlock& block = dae_.templateBlocks[k];
     std::vector<Expr> roots;
-    std::vector<const TemplateEntry*> entries;
+    std::vector<TemplateEntry*> entries;
     if (!jacobian) roots.push_back(block.residual);
-    for (const TemplateEntry& e : jac.templateEntries)
+    for (TemplateEntry& e : jac.templateEntries)
       if (jacobian && e.block == static_cast<int>(k)) roots.push_back(e.value), entries.push_back(&e);
     if (roots.empty()) return;
     sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, roots, "$b" + std::to_string(k) + (jacobian ? "j" : "r"));
@@ -495,7 +509,10 @@ class Builder {
     for (Expr t : invariantTemporaries(cse, operands)) b.lower(t);
     b.beginLoop(loopOver(b, block, base));
     if (!jacobian) b.storeLooped(static_cast<uint32_t>(block.firstRow + base), b.lower(cse.outputs[0]));
-    for (size_t e = 0; e < entries.size(); ++e) b.storeIndexed(b.appendIndexTable(entries[e]->positions), b.lower(cse.outputs[e]));
+    for (size_t e = 0; e < entries.size(); ++e) {
+      b.storeIndexed(b.appendIndexTable(entries[e]->positions), b.lower(cse.outputs[e]));
+      std::vector<uint32_t>().swap(entries[e]->positions);
+    }
     b.endLoop();
   }
 

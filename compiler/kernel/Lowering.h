@@ -56,6 +56,8 @@ class ProgramBuilder {
   void storeIndexed(uint32_t tableBase, uint32_t reg) { emit(Op::StoreIndexed, reg, 0, 0, tableBase); }
   /// Appends to the program's indexTable; returns the base index.
   uint32_t appendIndexTable(std::span<const uint32_t> values);
+  /// Room for `count` more indexTable entries (a large model appends millions).
+  void reserveIndexTable(size_t count) { program_.indexTable.reserve(program_.indexTable.size() + count); }
 
   /// A symbol met that has no binding (lowered as NaN), and the source whose code first used it.
   struct UnboundUse {
