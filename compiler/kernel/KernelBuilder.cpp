@@ -550,7 +550,9 @@ class Builder {
 
   uint32_t blockSource(size_t k) {
     const dae::TemplateBlock& block = dae_.templateBlocks[k];
-    std::string what = block.origin == flat::OriginKind::Kinematic ? "velocities" : "Euler-Lagrange equations";
+    std::string what = block.origin == flat::OriginKind::Kinematic      ? "velocities"
+                       : block.origin == flat::OriginKind::EulerLagrange ? "Euler-Lagrange equations"
+                                                                        : "equations";
     std::string region;
     for (auto [first, last] : block.region)
       region += (region.empty() ? "" : ", ") + std::to_string(first) + (last > first ? ":" + std::to_string(last) : "");
