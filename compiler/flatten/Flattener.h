@@ -204,6 +204,7 @@ class Flattener {
   size_t scalars_ = 0;
   sym::DirectionalDerivative timeDerivative_{ctx_};  ///< der(): memo shared by all calls
   SourceRange derivativeSite_;                       ///< the der() being expanded (for E0311)
+  std::string derivativeName_;                       ///< derivativeVariable's buffer for "der(x[1])"
 
   std::deque<Instance> instances_;  ///< [0] is the model; then components in creation order
   Instance* cur_ = nullptr;         ///< whose names the expressions being lowered use

@@ -105,7 +105,8 @@ struct Context::Impl {
 
   Context& ctx;
   Arena arena;                      ///< nodes and their operand arrays
-  size_t nodeCount = 0;
+  size_t nodeCount = 0;             ///< every node, symbols included
+  size_t tableCount = 0;            ///< nodes in the intern table (not symbols: see newSymbol)
   struct TableSlot {  // trivial, so a new table is not touched before it is advised
     uint64_t hash;
     Expr node;
@@ -122,11 +123,10 @@ struct Context::Impl {
   std::deque<std::string> symbolNames;  ///< by symbolId (deque keeps references stable)
   std::vector<Expr> symbols;            ///< by symbolId
   struct NameSlot {
-    uint64_t hash = 0;
-    uint32_t symbolId = 0;
-    bool used = false;
+    uint32_t tag = 0;     ///< low half of the name's hash (all the table's position needs)
+    uint32_t entry = 0;   ///< symbolId + 1; 0 = empty
   };
-  std::vector<NameSlot> symbolsByName;  ///< open addressing over the name hashes
+  std::vector<NameSlot> symbolsByName;  ///< open addressing over the name hashes (power-of-two size)
   std::vector<NodeMap<Expr>> diffMemo;  ///< by symbolId: node -> derivative
 
   /// Returns the unique node structurally equal to `key`, creating it if new (then its operands
@@ -138,14 +138,18 @@ struct Context::Impl {
   Expr makeMul(double coef, std::span<const Expr> bases, std::span<const Expr> exps);
   /// Rebuilds n with new children (args then exps), re-simplifying. Returns n if unchanged.
   Expr rebuild(Expr n, std::span<const Expr> kids);
-  /// The symbol with this name, or nullptr.
-  Expr findSymbol(std::string_view name, uint64_t hash) const;
-  void addSymbolName(uint64_t hash, uint32_t symbolId);
+  /// The slot of the symbol with this name in symbolsByName, or the empty slot where it belongs.
+  NameSlot& nameSlot(std::string_view name, uint64_t hash);
+  /// A symbol node with the next symbolId, stored without entering the intern table: a symbol is
+  /// only ever found by name, never by structure, so the table need not hold (or rehash) it.
+  Expr newSymbol(std::string_view name);
+  /// Room for `symbols` more symbols and `nodes` more interned nodes without rehashing.
+  void reserve(size_t symbols, size_t nodes);
 
  private:
   Expr store(const Node& key);
-  void growTable();
-  void growSymbolsByName();
+  void resizeTable(size_t size);
+  void resizeSymbolsByName(size_t size);
 };
 
 /// Accumulates constant + Σ coef·term and builds the canonical Add (flattening nested sums and

@@ -96,6 +96,9 @@ class Context {
   Expr symbol(std::string_view name);
   /// Lookup without creating; nullptr if none.
   Expr findSymbol(std::string_view name) const;
+  /// Room for `symbols` more symbols and `nodes` more other nodes: a caller about to make many (a
+  /// large array's variables) spares the tables rehashing as they grow. Never changes any result.
+  void reserve(size_t symbols, size_t nodes);
   const std::string& symbolName(Expr s) const;
   size_t symbolCount() const;
 
