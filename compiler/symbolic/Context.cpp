@@ -132,7 +132,7 @@ void Context::Impl::reserve(size_t moreSymbols, size_t moreNodes) {
   size_t nodes = tableCount + moreNodes;
   if (nodes * 2 > tableSize) resizeTable(std::bit_ceil(std::max<size_t>(nodes * 2, 1024)));
   size_t names = symbols.size() + moreSymbols;
-  if (names * 2 > symbolsByName.size()) resizeSymbolsByName(std::bit_ceil(std::max<size_t>(names * 2, 64)));
+  if (names * 2 > nameTableSize) resizeSymbolsByName(std::bit_ceil(std::max<size_t>(names * 2, 64)));
   if (names > symbols.capacity()) symbols.reserve(std::max(names, 2 * symbols.capacity()));
 }
 
@@ -189,14 +189,14 @@ Expr Context::symbol(std::string_view name) {
 }
 
 Expr Context::findSymbol(std::string_view name) const {
-  if (impl_->symbolsByName.empty()) return nullptr;
+  if (impl_->nameTableSize == 0) return nullptr;
   const Impl::NameSlot& slot = impl_->nameSlot(name, std::hash<std::string_view>{}(name));
   return slot.entry ? impl_->symbols[slot.entry - 1] : nullptr;
 }
 
 // Linear probing; a slot whose tag differs cannot hold the name, so most misses compare no string.
 Context::Impl::NameSlot& Context::Impl::nameSlot(std::string_view name, uint64_t hash) {
-  size_t mask = symbolsByName.size() - 1;
+  size_t mask = nameTableSize - 1;
   auto tag = static_cast<uint32_t>(hash);
   for (size_t i = hash & mask;; i = (i + 1) & mask) {
     NameSlot& slot = symbolsByName[i];
@@ -217,14 +217,15 @@ Expr Context::Impl::newSymbol(std::string_view name) {
 
 // A tag is the low half of the name's hash, so it places its slot in any table of up to 2^32 slots.
 void Context::Impl::resizeSymbolsByName(size_t size) {
-  std::vector<NameSlot> old(size);
-  old.swap(symbolsByName);
+  size_t oldSize = std::exchange(nameTableSize, size);
+  auto old = std::exchange(symbolsByName, allocateLarge<NameSlot>(size));
+  std::fill_n(symbolsByName.get(), size, NameSlot{0, 0});
   size_t mask = size - 1;
-  for (const NameSlot& s : old) {
-    if (!s.entry) continue;
-    size_t i = s.tag & mask;
+  for (size_t k = 0; k < oldSize; ++k) {
+    if (!old[k].entry) continue;
+    size_t i = old[k].tag & mask;
     while (symbolsByName[i].entry) i = (i + 1) & mask;
-    symbolsByName[i] = s;
+    symbolsByName[i] = old[k];
   }
 }
 

@@ -122,11 +122,12 @@ struct Context::Impl {
   std::vector<ConstantSlot> recentConstants = std::vector<ConstantSlot>(size_t{1} << kConstantCacheBits);
   std::deque<std::string> symbolNames;  ///< by symbolId (deque keeps references stable)
   std::vector<Expr> symbols;            ///< by symbolId
-  struct NameSlot {
-    uint32_t tag = 0;     ///< low half of the name's hash (all the table's position needs)
-    uint32_t entry = 0;   ///< symbolId + 1; 0 = empty
+  struct NameSlot {  // trivial, like TableSlot: a large table asks for huge pages before it is touched
+    uint32_t tag;    ///< low half of the name's hash (all the table's position needs)
+    uint32_t entry;  ///< symbolId + 1; 0 = empty
   };
-  std::vector<NameSlot> symbolsByName;  ///< open addressing over the name hashes (power-of-two size)
+  std::unique_ptr<NameSlot[]> symbolsByName;  ///< open addressing over the name hashes
+  size_t nameTableSize = 0;                   ///< a power of two, or 0
   std::vector<NodeMap<Expr>> diffMemo;  ///< by symbolId: node -> derivative
 
   /// Returns the unique node structurally equal to `key`, creating it if new (then its operands
