@@ -39,6 +39,26 @@ static void forEachScalarName(const std::string& base, const std::vector<int>& s
   }
 }
 
+namespace {
+
+// Many names in one buffer instead of a string each; viewed once all are written (the buffer moves
+// while it grows).
+struct NameBuffer {
+  std::string chars;
+  std::vector<size_t> ends;
+  /// The characters appended since the previous name are a name.
+  void finish() { ends.push_back(chars.size()); }
+  std::vector<std::string_view> views() const {
+    std::vector<std::string_view> out;
+    out.reserve(ends.size());
+    size_t begin = 0;
+    for (size_t end : ends) out.emplace_back(chars.data() + begin, end - begin), begin = end;
+    return out;
+  }
+};
+
+}  // namespace
+
 static std::vector<std::string> scalarNames(const std::string& base, const std::vector<int>& shape) {
   std::vector<std::string> names;
   forEachScalarName(base, shape, [&](std::string_view name) { names.emplace_back(name); });
@@ -161,12 +181,35 @@ int Flattener::derivativeVariable(int var, SourceRange where) {
          "cannot take the derivative of '" + std::string(out_.variables[var].name) + "' (a " + roleName(role) + ")",
          "higher derivatives are only available for coordinates: declare the variable as 'coordinate Real'");
   derivativeName_.assign("der(").append(out_.variables[var].name) += ')';
-  Expr symbol = ctx_.symbol(derivativeName_);
-  Variable d{.role = derRole, .symbol = symbol, .declRange = out_.variables[var].declRange};
+  return addDerivative(var, derRole, ctx_.symbol(derivativeName_));
+}
+
+int Flattener::addDerivative(int var, VarRole role, Expr symbol) {
+  Variable d{.role = role, .symbol = symbol, .declRange = out_.variables[var].declRange};
   d.derivativeOf = var;
   int index = addVariable(std::move(d));
   out_.variables[var].derivative = index;
   return index;
+}
+
+// Every coordinate has a velocity and an acceleration, used or not: der(x[1]), der(der(x[1])),
+// der(x[2]), … in the order derivativeVariable would make them, with their symbols made at once
+// (Context::symbols). A declaration lowered again after a dependency already has them.
+void Flattener::addCoordinateDerivatives(const Value& coordinates) {
+  std::vector<int> vars;
+  NameBuffer names;
+  for (Expr x : coordinates.elems) {
+    int var = out_.variableOf(x);
+    if (out_.variables[var].derivative >= 0) continue;
+    vars.push_back(var);
+    names.chars.append("der(").append(out_.variables[var].name) += ')';
+    names.finish();
+    names.chars.append("der(der(").append(out_.variables[var].name) += "))";
+    names.finish();
+  }
+  std::vector<Expr> symbols = ctx_.symbols(names.views());
+  for (size_t k = 0; k < vars.size(); ++k)
+    addDerivative(addDerivative(vars[k], VarRole::Velocity, symbols[2 * k]), VarRole::Acceleration, symbols[2 * k + 1]);
 }
 
 // A declaration's value, created on first use. Declarations may use each other in any order, and a
@@ -323,8 +366,7 @@ Value Flattener::createDeclaration(const Declaration& d, const sema::ModelSymbol
         out_.variables[var].fixed = coord && !promoted;
         connectorPotential_[var] = cur_->cls->isConnector() && !d.isFlow;
       }
-      if (coord)  // every coordinate has a velocity and an acceleration, used or not
-        for (Expr x : vars.elems) derivativeVariable(derivativeVariable(out_.variableOf(x), d.nameRange), d.nameRange);
+      if (coord) addCoordinateDerivatives(vars);
       applyAttributes(d, vars);
       return vars;
     }
@@ -357,11 +399,15 @@ Value Flattener::variablesFor(const Declaration& d, const std::vector<int>& shap
   const Instance* top = cur_;
   while (top->parent && top->parent->parent) top = top->parent;
   SourceRange where = top->decl ? top->decl->nameRange : d.nameRange;
+  NameBuffer names;
   forEachScalarName(cur_->prefix() + d.name, shape, [&](std::string_view name) {
-    Expr symbol = ctx_.symbol(name);
+    names.chars += name;
+    names.finish();
+  });
+  for (Expr symbol : ctx_.symbols(names.views())) {
     addVariable({.role = role, .symbol = symbol, .declRange = where, .description = d.description});
     v.elems.push_back(symbol);
-  });
+  }
   slot.variables = std::move(v);
   slot.hasVariables = true;
   return slot.variables;

@@ -178,12 +178,31 @@ Expr Context::constant(double v) {
 void Context::reserve(size_t symbols, size_t nodes) { impl_->reserve(symbols, nodes); }
 
 Expr Context::symbol(std::string_view name) {
-  Impl& m = *impl_;
-  m.reserve(1, 0);
-  uint64_t hash = std::hash<std::string_view>{}(name);
-  Impl::NameSlot& slot = m.nameSlot(name, hash);
-  if (slot.entry) return m.symbols[slot.entry - 1];
-  Expr s = m.newSymbol(name);
+  impl_->reserve(1, 0);
+  return impl_->symbol(name, std::hash<std::string_view>{}(name));
+}
+
+// Hashes every name first; then, while one name is looked up, the slot of a name some places
+// further on is already being loaded (the table is reserved up front, so it does not move).
+std::vector<Expr> Context::symbols(std::span<const std::string_view> names) {
+  constexpr size_t kAhead = 16;
+  impl_->reserve(names.size(), 0);
+  std::vector<uint64_t> hashes(names.size());
+  for (size_t i = 0; i < names.size(); ++i) hashes[i] = std::hash<std::string_view>{}(names[i]);
+  std::vector<Expr> out;
+  out.reserve(names.size());
+  size_t mask = impl_->nameTableSize - 1;
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (i + kAhead < names.size()) __builtin_prefetch(&impl_->symbolsByName[hashes[i + kAhead] & mask]);
+    out.push_back(impl_->symbol(names[i], hashes[i]));
+  }
+  return out;
+}
+
+Expr Context::Impl::symbol(std::string_view name, uint64_t hash) {
+  NameSlot& slot = nameSlot(name, hash);
+  if (slot.entry) return symbols[slot.entry - 1];
+  Expr s = newSymbol(name);
   slot = {static_cast<uint32_t>(hash), s->symbolId + 1};
   return s;
 }

@@ -141,6 +141,8 @@ struct Context::Impl {
   Expr rebuild(Expr n, std::span<const Expr> kids);
   /// The slot of the symbol with this name in symbolsByName, or the empty slot where it belongs.
   NameSlot& nameSlot(std::string_view name, uint64_t hash);
+  /// The symbol with this name, made if new; the name table must have room for one more.
+  Expr symbol(std::string_view name, uint64_t hash);
   /// A symbol node with the next symbolId, stored without entering the intern table: a symbol is
   /// only ever found by name, never by structure, so the table need not hold (or rehash) it.
   Expr newSymbol(std::string_view name);
