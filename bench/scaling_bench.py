@@ -11,6 +11,10 @@ For each n, one fresh process each (peak memory by wait4's ru_maxrss):
     horizon, same tolerances.
 Prints a markdown table (time per stage, file to first step, peak memory, both programs side by
 side) and the fitted exponent of each column between consecutive sizes (t ~ n^k).
+
+Then the whole process at issue 15's setting (rtol 1e-6, 1 s, KLU, columns x[1] and x[n]) for
+n = 10^3 ... 10^5 (--whole-sizes): `qdot run` in its default mode (tiering) against the hand-written
+program, wall time and peak memory, best of --repeat runs (one fresh process each).
 """
 import argparse
 import math
@@ -61,6 +65,56 @@ def measure(build, n, stop):
             "hsetup": hsetup}
 
 
+def whole(build, n, stop, repeat):
+    """Whole process at the issue's setting: qdot run (default mode) and the hand-written program."""
+    common = ["--stop", str(stop), "--outputs", f"x[1],x[{n}]", "-o", "/dev/null"]
+    qdot = [f"{build}/qdot", "run", CHAIN, "-p", f"n={n}", "--no-progress"] + common
+    hand = [f"{build}/bench/reference_sim", "chain", "--n", str(n)] + common
+    best = {}
+    for _ in range(repeat):
+        for key, command in (("qdot", qdot), ("hand", hand)):
+            wall, peak, _ = peak_of(command)
+            w, p = best.get(key, (float("inf"), float("inf")))
+            best[key] = (min(w, wall), min(p, peak))
+    return {"n": n, "qwall": best["qdot"][0], "qpeak": best["qdot"][1], "hwall": best["hand"][0], "hpeak": best["hand"][1]}
+
+
+SMALL = [("N-link pendulum n = 8", "examples/pendulum/nlink.qd", ["-p", "n=8"]),
+         ("double pendulum", "examples/pendulum/double_pendulum.qd", []),
+         ("spring chain n = 10", CHAIN, [])]
+
+
+def small_models(build, repeat):
+    """Small models stay small: file -> first step on the VM (`--backend bytecode`, horizon 1e-4 s),
+    best of `repeat` fresh processes, with the compile time --stats reports."""
+    rows = []
+    for name, path, extra in SMALL:
+        command = [f"{build}/qdot", "run", path, *extra, "--stop", "1e-4", "--interval", "1e-4", "--backend", "bytecode",
+                   "-o", "/dev/null", "--stats", "--no-progress"]
+        best_wall, best_inside = float("inf"), float("inf")
+        for _ in range(repeat):
+            wall, _, err = peak_of(command)
+            best_wall = min(best_wall, wall)
+            inside = number(r"; total ([0-9.e+-]+)", err) / 1e3 + number(r"setup ([0-9.e+-]+) s", err)
+            best_inside = min(best_inside, inside)
+        rows.append((name, best_wall, best_inside))
+    print(f"\n## Small models: file to first step on the VM (best of {repeat} processes)\n")
+    print("| model | **file → first step**: compile + IDA setup (--stats) [ms] | whole process to t = 1e-4 s, with the process start [ms] |")
+    print("| --- | ---: | ---: |")
+    for name, wall, inside in rows:
+        print(f"| {name} | {inside * 1e3:.2f} | {wall * 1e3:.1f} |")
+
+
+def print_whole(rows, stop, repeat):
+    print(f"\n## Whole process, issue 15's setting (rtol 1e-6, {stop:g} s, KLU, columns x[1], x[n]; "
+          f"default mode; best of {repeat})\n")
+    print("| n | qdot [s] | hand-written [s] | **time ratio** | qdot peak [MiB] | hand-written peak [MiB] | **memory ratio** |")
+    print("| ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for r in rows:
+        print(f"| {r['n']:,} | {r['qwall']:.2f} | {r['hwall']:.2f} | **{r['qwall'] / r['hwall']:.2f}** | "
+              f"{r['qpeak']:.0f} | {r['hpeak']:.0f} | **{r['qpeak'] / r['hpeak']:.2f}** |".replace(",", " "))
+
+
 def exponent(a, b, key):
     if a[key] <= 0 or b[key] <= 0 or any(map(math.isnan, (a[key], b[key]))):
         return float("nan")
@@ -73,6 +127,9 @@ def main():
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--sizes", default=None)
     ap.add_argument("--stop", type=float, default=1e-4)
+    ap.add_argument("--whole-sizes", default=None, help="n for the whole-process table (default 1000,10000,100000; 'none' skips it)")
+    ap.add_argument("--whole-stop", type=float, default=1.0)
+    ap.add_argument("--repeat", type=int, default=1)
     a = ap.parse_args()
     sizes = [int(s) for s in a.sizes.split(",")] if a.sizes else ([1000, 10000, 100000] if a.quick else
                                                                    [1000, 10000, 100000, 1000000])
@@ -95,6 +152,11 @@ def main():
         print("|---|" + "---:|" * len(cols))
         for x, y in zip(rows, rows[1:]):
             print(f"| {x['n']} → {y['n']} | " + " | ".join(f"{exponent(x, y, c):.2f}" for c in cols) + " |")
+    small_models(a.build, 10)
+    if a.whole_sizes != "none":
+        whole_sizes = [int(s) for s in a.whole_sizes.split(",")] if a.whole_sizes else (
+            [1000, 10000] if a.quick else [1000, 10000, 100000])
+        print_whole([whole(a.build, n, a.whole_stop, a.repeat) for n in whole_sizes], a.whole_stop, a.repeat)
 
 
 if __name__ == "__main__":

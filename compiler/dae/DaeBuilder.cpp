@@ -2,6 +2,7 @@
 // adds the kinematic rows q' = der(q), and checks the balance of equations and unknowns.
 #include "dae/Dae.h"
 #include "dae/Balance.h"
+#include "dae/TemplateOde.h"
 #include "support/Assert.h"
 
 #include <algorithm>
@@ -27,6 +28,11 @@ class Builder {
     dae_.structuralParameters = m_.structuralParameters;
     dae_.unconnected = m_.unconnected;
     dae_.outputs = m_.outputs;
+    if (!m_.equationTemplates.empty()) {  // an explicit ODE (isTemplatedOde): balanced by construction
+      addParameters();
+      addTemplatedOde(m_, ctx_, dae_);
+      return std::move(dae_);
+    }
     collectAliases();
     addParameters();
     addEquations();
@@ -110,36 +116,49 @@ class Builder {
 
   // Coordinates first, then velocities (spec §5). A coordinate whose row contains no velocity at
   // all is algebraic (massless node); one with velocity only through forces or dissipation keeps q
-  // as a state and its velocity algebraic.
+  // as a state and its velocity algebraic. Written in place (two passes over the rows): a large
+  // model's unknowns and kinematic rows are not built in temporaries and then moved.
   void addMechanics() {
-    std::vector<Variable> velocities;
-    velocities.reserve(eom_.rows.size());
     markAppearances();
-    for (const auto& row : eom_.rows) {
+    enum : char { Skip, Algebraic, NotInertial, Inertial };
+    std::vector<char> kindOf(eom_.rows.size(), Skip);
+    for (size_t r = 0; r < eom_.rows.size(); ++r) {
+      const auto& row = eom_.rows[r];
       const flat::Variable& q = m_.variables[row.coordinate];
       if (q.alias) continue;  // its row stays an equation; it is another variable
       const flat::Variable& v = m_.variables[q.derivative];
-      const flat::Variable& a = m_.variables[v.derivative];
       // Inertia shows as the acceleration in some row (an aliased coordinate's row counts).
-      bool inertial = row.templateRow >= 0 || appears(a.symbol);
+      bool inertial = row.templateRow >= 0 || appears(m_.variables[v.derivative].symbol);
+      kindOf[r] = inertial ? Inertial : appears(v.symbol) ? NotInertial : Algebraic;
+    }
+    size_t states = std::count_if(kindOf.begin(), kindOf.end(), [](char k) { return k == Inertial || k == NotInertial; });
+    kinematic_.reserve(states);
+    kinematicPairs_.reserve(states);
+    for (size_t r = 0; r < eom_.rows.size(); ++r) {
+      if (kindOf[r] == Skip) continue;
+      const flat::Variable& q = m_.variables[eom_.rows[r].coordinate];
       dae_.coordinates.push_back(static_cast<int>(dae_.variables.size()));
-      if (!inertial && !appears(v.symbol)) {
-        dae_.variables.push_back(fromFlat(row.coordinate, VarKind::Algebraic, UnknownRole::Coordinate));
+      if (kindOf[r] == Algebraic) {
+        dae_.variables.push_back(fromFlat(eom_.rows[r].coordinate, VarKind::Algebraic, UnknownRole::Coordinate));
         continue;
       }
-      Variable qv = fromFlat(row.coordinate, VarKind::State, UnknownRole::Coordinate);
+      Variable qv = fromFlat(eom_.rows[r].coordinate, VarKind::State, UnknownRole::Coordinate);
       qv.yp = ctx_.symbol("$der(" + std::string(q.name) + ")");
-      kinematic_.push_back({ctx_.sub(qv.yp, v.symbol), {flat::OriginKind::Kinematic, q.declRange, row.coordinate, ""}});
-      kinematicPairs_.push_back({static_cast<int>(dae_.variables.size()), static_cast<int>(velocities.size())});
+      kinematic_.push_back({ctx_.sub(qv.yp, m_.variables[q.derivative].symbol),
+                            {flat::OriginKind::Kinematic, q.declRange, eom_.rows[r].coordinate, ""}});
+      kinematicPairs_.push_back({static_cast<int>(dae_.variables.size()), static_cast<int>(kinematicPairs_.size())});
       dae_.variables.push_back(std::move(qv));
-      Variable vv = fromFlat(q.derivative, inertial ? VarKind::State : VarKind::Algebraic, UnknownRole::Velocity);
-      vv.declaration.start = v.start ? v.start : ctx_.zero();  // a velocity starts at 0 unless an initial equation says otherwise
-      if (inertial) vv.yp = a.symbol;
-      velocities.push_back(std::move(vv));
     }
     int firstVelocity = static_cast<int>(dae_.variables.size());
-    dae_.variables.insert(dae_.variables.end(), std::make_move_iterator(velocities.begin()),
-                          std::make_move_iterator(velocities.end()));
+    for (size_t r = 0; r < eom_.rows.size(); ++r) {
+      if (kindOf[r] != Inertial && kindOf[r] != NotInertial) continue;
+      const flat::Variable& q = m_.variables[eom_.rows[r].coordinate];
+      const flat::Variable& v = m_.variables[q.derivative];
+      Variable vv = fromFlat(q.derivative, kindOf[r] == Inertial ? VarKind::State : VarKind::Algebraic, UnknownRole::Velocity);
+      vv.declaration.start = v.start ? v.start : ctx_.zero();  // a velocity starts at 0 unless an initial equation says otherwise
+      if (kindOf[r] == Inertial) vv.yp = m_.variables[v.derivative].symbol;
+      dae_.variables.push_back(std::move(vv));
+    }
     int row = static_cast<int>(eom_.rows.size());  // the kinematic rows follow the Euler–Lagrange rows
     for (auto [coordinate, velocity] : kinematicPairs_) dae_.links.push_back({row++, coordinate, firstVelocity + velocity});
   }
@@ -170,7 +189,8 @@ class Builder {
   }
 
   void addEquations() {
-    dae_.equations.reserve(eom_.rows.size() + kinematic_.size() + m_.equations.size() + m_.constraints.size());
+    // At most one kinematic row per Euler–Lagrange row (inserted after them by insertKinematicRows).
+    dae_.equations.reserve(2 * eom_.rows.size() + m_.equations.size() + m_.constraints.size());
     for (const auto& row : eom_.rows) {
       const flat::Variable& q = m_.variables[row.coordinate];
       dae_.equations.push_back({substituted(row.residual), {flat::OriginKind::EulerLagrange, q.declRange, row.coordinate, ""}});

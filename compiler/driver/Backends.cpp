@@ -33,7 +33,9 @@ bool compileNativeFirst(Compilation& c, bool invariants, RunnableModel& out) {
 // The VM model; false (with out.error) if the bytecode does not load, which is a bug.
 bool loadBytecode(Compilation& c, RunnableModel& out) {
   if (!continueTo(c, Stage::Bytecode)) return false;
-  Result<ModelPtr> model = vm::createModel(*c.bytecode);
+  // qdot run needs the module only in the model: moved, not copied (releaseStages, Pipeline.h).
+  Result<ModelPtr> model = c.options.releaseStages ? vm::createModel(std::move(*c.bytecode)) : vm::createModel(*c.bytecode);
+  if (c.options.releaseStages) c.bytecode.reset();
   if (model) out.model = std::move(model).value();
   else out.error = model.error();
   out.what = "bytecode";
@@ -71,7 +73,7 @@ void addBackgroundJit(const Compilation& c, rt::TierTrigger trigger, RunnableMod
       [kernels = c.kernels, sources, options, jit = out.jit](const std::atomic<bool>& cancel) {
         llvmbackend::JitOptions withCancel = options;
         withCancel.cancel = &cancel;
-        Result<ModelPtr> model = llvmbackend::createJitModel(*kernels, *sources, withCancel, &jit->stats);
+        Result<ModelPtr> model = llvmbackend::createJitModel(kernels, *sources, withCancel, &jit->stats);
         if (!model) jit->error = model.error();
         return model ? std::move(model).value() : ModelPtr();
       },

@@ -17,6 +17,7 @@
 #include "bodies/RigidBodies.h"
 #include "bytecode/Emitter.h"
 #include "dae/IndexReduction.h"
+#include "dae/TemplateOde.h"
 #include "syntax/Parser.h"
 
 namespace qdot::driver {
@@ -92,10 +93,51 @@ void returnFreedMemory() {
 #endif
 }
 
+// `der(x[i, …]) = …`, the form of the equations a `for` loop may keep as one template.
+bool isOwnDerivativeEquation(const ast::Equation& eq) {
+  if (eq.kind == ast::EquationKind::For) {
+    auto own = [](const ast::Equation& e) { return isOwnDerivativeEquation(e); };
+    return !eq.body.empty() && std::all_of(eq.body.begin(), eq.body.end(), own);
+  }
+  auto* call = eq.kind == ast::EquationKind::Simple && eq.lhs ? ast::dyn_cast<ast::CallExpr>(eq.lhs.get()) : nullptr;
+  return call && call->callee->dotted() == "der" && call->args.size() == 1 && ast::dyn_cast<ast::IndexExpr>(call->args[0].get());
+}
+
+// Whether `for` equations may stay templates (docs/loops.md), from the syntax: a run that keeps
+// loops and needs no invariants, of a model of equations only — no mechanics, initial equations or
+// components — with a `for` loop of `der(x[i]) = …` equations. Flattening then keeps them only if
+// the model is an explicit ODE (dae::isTemplatedOde), else it flattens again.
+bool forEquationsMayStay(const Compilation& c) {
+  const sema::CheckedClass& root = *c.checked->root;
+  if (!c.options.keepLoops || c.options.keepInvariants || !root.mechanics.empty() || !root.initialEquations.empty())
+    return false;
+  for (const auto& [name, symbol] : root.symbols)
+    if (symbol.kind == sema::SymbolKind::Component) return false;
+  return std::any_of(root.equations.begin(), root.equations.end(), [](const ast::Equation* eq) {
+    return eq->kind == ast::EquationKind::For && isOwnDerivativeEquation(*eq);
+  });
+}
+
+// Flattening with the `for` equations kept as templates, silently (its diagnostics are dropped):
+// the model, if it is an explicit ODE whose DAE keeps them and nothing was reported; else nullopt
+// and a Context as new, so that flattening again gives exactly what it gives without this attempt.
+std::optional<flat::FlatModel> flattenKeepingEquations(Compilation& c, flat::FlattenLimits limits) {
+  limits.keepForEquations = true;
+  DiagnosticEngine attempt;
+  auto model = flat::flatten(*c.checked, c.ctx, attempt, limits, c.options.structural);
+  if (model && attempt.diagnostics().empty() && !model->equationTemplates.empty() && dae::isTemplatedOde(*model, c.ctx))
+    return model;
+  model.reset();
+  c.ctx.clear();
+  return std::nullopt;
+}
+
 bool flatten(Compilation& c) {
   c.flat = timed(c.times.flatten, [&] {
     flat::FlattenLimits limits = c.options.limits;
     limits.keepLoops = true;
+    if (forEquationsMayStay(c))
+      if (auto model = flattenKeepingEquations(c, limits)) return model;
     auto model = flat::flatten(*c.checked, c.ctx, c.diags, limits, c.options.structural);
     if (model && !templatesApply(*model, c.options, c.ctx)) flat::expandIndexedSums(*model, c.ctx);
     return model;
@@ -150,7 +192,7 @@ bool emitBytecode(Compilation& c) {
 // A JIT failure is not an error in the model: c.internalError says what failed.
 bool compileNative(Compilation& c) {
   Result<ModelPtr> model =
-      timed(c.times.native, [&] { return llvmbackend::createJitModel(*c.kernels, c.sources, c.options.jit, &c.jitStats); });
+      timed(c.times.native, [&] { return llvmbackend::createJitModel(c.kernels, c.sources, c.options.jit, &c.jitStats); });
   if (!model) {
     c.internalError = "the LLVM JIT failed: " + model.error();
     return false;

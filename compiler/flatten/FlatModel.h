@@ -191,6 +191,17 @@ struct IndexedSum {
   SourceRange range;  ///< the sum(...) call
 };
 
+/// `for i in a:b, j in c:d loop der(x[i, j]) = rhs; end for` kept as one template instead of one
+/// equation per point (issue 15, docs/loops.md): the equation at every point of the box, its sides
+/// over relative symbols (`der(x)[%1,%2]`, `x[%1+1,%2]`), parameters and time. Only the loops whose
+/// body is `der(x[i, …]) = …` with x indexed by the iterators in order, and only when flattened with
+/// FlattenLimits::keepForEquations.
+struct EquationTemplate {
+  Box box;  ///< per iterator (nested loops: outer first): first and last value
+  sym::Expr lhs = nullptr, rhs = nullptr;
+  Origin origin;  ///< the equation inside the loop (no element)
+};
+
 struct Experiment {
   std::optional<double> startTime, stopTime, interval, tolerance;
 };
@@ -211,6 +222,9 @@ struct FlatModel {
   /// expandIndexedSums): the sums, the arrays their relative symbols index, and those symbols.
   std::vector<IndexedSum> indexedSums;
   std::shared_ptr<ElementPatterns> patterns = std::make_shared<ElementPatterns>();
+  /// `for` equations kept as templates (FlattenLimits::keepForEquations); their points are not in
+  /// `equations`.
+  std::vector<EquationTemplate> equationTemplates;
   /// The component instances, by path ("m1", "ms[2]", "sys.m1"); [0] is the model itself ("").
   std::vector<std::string> components;
   /// Components' connectors joined to nothing (their flows are 0), by path, with the component's

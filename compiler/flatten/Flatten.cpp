@@ -491,6 +491,8 @@ void Flattener::applyAttributeList(const std::vector<ast::Modification>& mods, c
 
 void Flattener::lowerEquation(const ast::Equation& eq, std::vector<flat::Equation>& into, OriginKind kind) {
   if (eq.kind == EquationKind::For) {
+    bool topLevel = iterators_.empty() && kind == OriginKind::Equation;
+    if (limits_.keepForEquations && topLevel && lowerEquationTemplates(eq)) return;
     forEachIteration(eq.iterators, 0, [&] {
       for (const auto& b : eq.body) guarded([&] { lowerEquation(b, into, kind); });
     });

@@ -20,6 +20,10 @@ struct FlattenLimits {
   /// Keep `sum(... for i in a:b)` in energies as IndexedSums (templates) where its body indexes
   /// arrays by the iterator plus constants (docs/loops.md); otherwise every sum is expanded.
   bool keepLoops = false;
+  /// Keep top-level `for` equations of the form `der(x[i, …]) = rhs` whose rhs indexes arrays by the
+  /// iterators plus constants as EquationTemplates (docs/loops.md); any other equation is expanded.
+  /// Only for a model the pipeline then checks with dae::isTemplatedOde (else it flattens again).
+  bool keepForEquations = false;
 };
 
 /// Values that replace the bindings of scalar Integer parameters (`qdot run -p n=3`): the model

@@ -290,6 +290,11 @@ class Flattener {
   int arrayOf(const Value& declared, const std::string& name);
   long plainInteger(const ast::Expr& e);
   sym::Expr rateOfRelative(const RelativeElement& rel);
+  bool addTemplateIterator(const ast::Iterator& it, std::vector<TemplateIterator>& its);
+  bool lowerEquationTemplates(const ast::Equation& loop);
+  std::optional<std::vector<TemplateIterator>> equationTemplateIterators(const ast::Equation*& innermost);
+  std::optional<EquationTemplate> lowerEquationTemplate(const ast::Equation& eq, const std::vector<TemplateIterator>& its);
+  bool ratesOfUnknowns_ = false;  ///< lowering an equation template: der() of an array of unknowns is an array
   std::vector<TemplateIterator> templateIterators_;  ///< of the sum being lowered as a template
   std::map<const Value*, int> arrayIds_;             ///< declared arrays met in templates
 

@@ -4,6 +4,8 @@
 // each such subscript a *relative symbol* (`x[%1+1]`), instead of once per element. Anything else
 // is lowered as before, so a template is only ever an exact rewriting of what expansion gives
 // (expandIndexedSums turns it back; tests/unit/IndexedSumTest.cpp checks node identity).
+// With FlattenLimits::keepForEquations, a top-level `for` equation `der(x[i]) = rhs` is lowered
+// the same way, once (EquationTemplate).
 #include <algorithm>
 #include <cmath>
 
@@ -180,22 +182,28 @@ void Flattener::addTermsKeepingLoops(std::vector<Term>& into, const MechanicsStm
   into.push_back({ctx_.add(scalars), st.range});
 }
 
+// Appends a loop's iterator `a:b` to `its` if it can be a template's: plain integer bounds that
+// name no earlier iterator, a range that is not empty, a name not taken by an earlier iterator.
+bool Flattener::addTemplateIterator(const ast::Iterator& it, std::vector<TemplateIterator>& its) {
+  auto* r = dyn_cast<RangeExpr>(it.range.get());
+  if (!r || !r->start || !r->stop || r->step) return false;
+  if (mentions(r->start.get(), its) || mentions(r->stop.get(), its)) return false;
+  if (std::any_of(its.begin(), its.end(), [&](const TemplateIterator& o) { return o.name == it.name; })) return false;
+  // Bounds that are not plain integers (1:1e300, 1:2.5) are the scalar lowering's to report.
+  Expr lo = lowerScalar(*r->start, "a loop range"), hi = lowerScalar(*r->stop, "a loop range");
+  auto plain = [](Expr v) { return v->isConstant() && std::abs(v->value) < 1e9 && v->value == std::floor(v->value); };
+  if (!plain(lo) || !plain(hi) || hi->value < lo->value) return false;  // an empty loop: the scalar lowering's nothing
+  its.push_back({it.name, static_cast<long>(lo->value), static_cast<long>(hi->value)});
+  return true;
+}
+
 // Lowers the sum as a template; false (nothing reported, nothing recorded) where the scalar
 // lowering must do it.
 bool Flattener::lowerIndexedSum(const CallExpr& call, bool negated, IndexedSum& sum) {
   const auto& comp = *cast<ComprehensionExpr>(call.args[0].get());
   std::vector<TemplateIterator> its;
-  for (const auto& it : comp.iterators) {
-    auto* r = dyn_cast<RangeExpr>(it.range.get());
-    if (!r || !r->start || !r->stop || r->step) return false;
-    if (mentions(r->start.get(), its) || mentions(r->stop.get(), its)) return false;
-    // Bounds that are not plain integers (1:1e300, 1:2.5) are the scalar lowering's to report.
-    Expr lo = lowerScalar(*r->start, "a loop range"), hi = lowerScalar(*r->stop, "a loop range");
-    auto plain = [](Expr v) { return v->isConstant() && std::abs(v->value) < 1e9 && v->value == std::floor(v->value); };
-    if (!plain(lo) || !plain(hi)) return false;
-    its.push_back({it.name, static_cast<long>(lo->value), static_cast<long>(hi->value)});
-    if (its.back().last < its.back().first) return false;  // an empty sum: 0, as the scalar lowering gives
-  }
+  for (const auto& it : comp.iterators)
+    if (!addTemplateIterator(it, its)) return false;
   if (!TemplateCheck(its).body(*comp.body)) return false;
   templateIterators_ = std::move(its);
   try {
@@ -212,6 +220,83 @@ bool Flattener::lowerIndexedSum(const CallExpr& call, bool negated, IndexedSum& 
   sum.range = call.range;
   templateIterators_.clear();
   return true;
+}
+
+// --- for equations (FlattenLimits::keepForEquations) ---
+
+namespace {
+
+// `der(x[i, j])` with i, j the template's iterators in order: the element a row of the template
+// defines the derivative of.
+bool isOwnDerivative(const ast::Expr& e, const TemplateCheck& check, size_t iterators) {
+  auto* c = dyn_cast<CallExpr>(&e);
+  if (!c || c->callee->dotted() != "der" || c->args.size() != 1 || !c->namedArgs.empty()) return false;
+  auto* x = dyn_cast<IndexExpr>(c->args[0].get());
+  auto* base = x ? dyn_cast<NameExpr>(x->base.get()) : nullptr;
+  if (!base || base->parts.size() != 1 || check.iteratorIndex(*base) >= 0 || x->subscripts.size() != iterators) return false;
+  for (size_t d = 0; d < iterators; ++d) {
+    auto* s = dyn_cast<NameExpr>(x->subscripts[d].get());
+    if (!s || check.iteratorIndex(*s) != static_cast<int>(d)) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+// The iterators of a top-level `for` equation and of the loops nested in it while each loop holds
+// only the next (`for i … loop for j … loop … end for; end for`); `innermost` becomes the loop whose
+// body holds the equations. nullopt where a loop cannot be a template's.
+std::optional<std::vector<TemplateIterator>> Flattener::equationTemplateIterators(const ast::Equation*& innermost) {
+  std::vector<TemplateIterator> its;
+  for (const ast::Equation* loop = innermost;; loop = &loop->body[0]) {
+    for (const auto& it : loop->iterators)
+      if (!addTemplateIterator(it, its)) return std::nullopt;
+    innermost = loop;
+    if (loop->body.size() != 1 || loop->body[0].kind != EquationKind::For) return its;
+  }
+}
+
+// Every equation of the loop as a template, or false (nothing recorded) where the scalar lowering
+// must do the loop: an equation of another form than `der(x[i, …]) = rhs`, a body TemplateCheck
+// refuses, a subscript out of bounds.
+bool Flattener::lowerEquationTemplates(const ast::Equation& loop) {
+  const ast::Equation* innermost = &loop;
+  std::optional<std::vector<TemplateIterator>> its = equationTemplateIterators(innermost);
+  if (!its || innermost->body.empty()) return false;
+  std::vector<EquationTemplate> templates;
+  for (const auto& eq : innermost->body) {
+    std::optional<EquationTemplate> t = lowerEquationTemplate(eq, *its);
+    if (!t) return false;
+    templates.push_back(std::move(*t));
+  }
+  countScalars(pointCount(templates[0].box) * templates.size(), loop.range);
+  for (EquationTemplate& t : templates) out_.equationTemplates.push_back(std::move(t));
+  return true;
+}
+
+std::optional<EquationTemplate> Flattener::lowerEquationTemplate(const ast::Equation& eq,
+                                                                 const std::vector<TemplateIterator>& its) {
+  TemplateCheck check(its);
+  if (eq.kind != EquationKind::Simple || !eq.lhs || !eq.rhs) return std::nullopt;
+  if (!isOwnDerivative(*eq.lhs, check, its.size()) || !check.body(*eq.rhs)) return std::nullopt;
+  EquationTemplate t;
+  templateIterators_ = its;
+  ratesOfUnknowns_ = true;
+  auto done = [&] { templateIterators_.clear(), ratesOfUnknowns_ = false; };
+  try {
+    t.lhs = lowerScalar(*eq.lhs, "the left side of an equation");
+    t.rhs = lowerScalar(*eq.rhs, "the right side of an equation");
+  } catch (NotATemplate&) {
+    done();
+    return std::nullopt;
+  } catch (...) {
+    done();
+    throw;
+  }
+  done();
+  for (const auto& it : its) t.box.push_back({it.first, it.last});
+  t.origin = {OriginKind::Equation, eq.range, -1, "", cur_->index};
+  return t;
 }
 
 // x[i+1] inside a template: the relative symbol of that pattern (nullopt: no iterator in the
@@ -267,13 +352,14 @@ int Flattener::arrayOf(const Value& declared, const std::string& name) {
 Expr Flattener::relativeSymbol(const RelativeElement& rel) { return out_.patterns->symbol(ctx_, rel); }
 
 // der(x[%1+1]) = der(x)[%1+1]: the array of the elements' derivatives, made once. Only arrays of
-// coordinates and velocities (whose derivatives every element has in the scalar lowering too) and
-// of parameters and constants (derivative 0).
+// coordinates and velocities (whose derivatives every element has in the scalar lowering too), of
+// parameters and constants (derivative 0), and in an equation template of unknowns (every element
+// gets its der(): the model is templated only if each is then defined by an equation).
 Expr Flattener::rateOfRelative(const RelativeElement& rel) {
   ArrayVariable& a = out_.patterns->arrays[rel.array];
   if (a.derivative < 0) {
     std::vector<Expr> rates;
-    bool constant = true, moving = true;
+    bool constant = true, moving = true, unknowns = ratesOfUnknowns_;
     for (Expr e : a.elements) {
       int var = out_.variableOf(e);
       VarRole role = var >= 0 ? out_.variables[var].role : VarRole::Parameter;
@@ -281,9 +367,11 @@ Expr Flattener::rateOfRelative(const RelativeElement& rel) {
       bool isMoving = var >= 0 && (role == VarRole::Coordinate || role == VarRole::Velocity);
       constant &= isConstant;
       moving &= isMoving;
+      unknowns &= var >= 0 && role == VarRole::Unknown;
     }
     if (constant) return ctx_.zero();
-    if (!moving) throw NotATemplate{};
+    if (!moving && !unknowns) throw NotATemplate{};
+    rates.reserve(a.elements.size());
     for (Expr e : a.elements) rates.push_back(out_.variables[derivativeVariable(out_.variableOf(e), derivativeSite_)].symbol);
     int id = static_cast<int>(out_.patterns->arrays.size());
     out_.patterns->arrays.push_back({"der(" + a.name + ")", a.shape, std::move(rates)});

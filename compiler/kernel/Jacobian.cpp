@@ -1,12 +1,14 @@
-// differentiate: each equation's gradient over the unknowns it contains comes from one sparse pass
+// differentiate: each scalar row's gradient over the unknowns it contains comes from one sparse pass
 // (sym::PartialDerivatives), so the work is proportional to the nonzeros and to what they depend
 // on, not to n² (nor to n per symbol, as Context::diff would be once symbols alias in the mask).
+// A template block is differentiated once; its rows' entries are only counted and placed, never
+// listed one by one, so the pattern of a model of 10⁶ elements costs its CSC arrays and little else.
 #include "kernel/Jacobian.h"
 
 #include <algorithm>
 #include <optional>
-#include <unordered_map>
 
+#include "kernel/SymbolSlots.h"
 #include "support/Assert.h"
 #include "symbolic/NodeMap.h"
 
@@ -15,86 +17,156 @@ namespace {
 
 constexpr uint32_t kNone = UINT32_MAX;
 
-// The DAE's unknowns as distinct symbols (every y and y'), with the variable each one belongs to.
-// A symbol listed twice belongs to the last variable naming it.
-struct Unknowns {
-  std::vector<sym::Expr> symbols;
-  std::vector<int32_t> variableOf;   // by position in symbols
-  std::vector<uint32_t> positionOf;  // by symbolId; kNone: not an unknown
-
-  explicit Unknowns(const dae::Dae& dae) {
-    for (int32_t j = 0; j < static_cast<int32_t>(dae.variables.size()); ++j) {
-      add(dae.variables[j].y, j);
-      if (dae.variables[j].yp) add(dae.variables[j].yp, j);
+// The distinct unknowns the scalar rows read, for sym::PartialDerivatives: every y and y' when no
+// template serves rows (each is read somewhere), else those found in one walk of the scalar rows
+// (a few boundary rows next to millions of template elements).
+std::vector<sym::Expr> scalarUnknowns(const dae::Dae& dae, std::span<const int32_t> rows, const UnknownSymbols& unknowns) {
+  std::vector<sym::Expr> out;
+  sym::NodeSet seen;
+  auto visit = [&](sym::Expr s) {
+    if (seen.insert(s)) out.push_back(s);
+  };
+  if (!dae.templated()) {
+    for (const dae::Variable& v : dae.variables) {
+      visit(v.y);
+      if (v.yp) visit(v.yp);
     }
+    return out;
   }
-  void add(sym::Expr s, int32_t j) {
-    if (positionOf.size() <= s->symbolId) positionOf.resize(s->symbolId + 1, kNone);
-    uint32_t& k = positionOf[s->symbolId];
-    if (k == kNone) k = static_cast<uint32_t>(symbols.size()), symbols.push_back(s), variableOf.push_back(j);
-    else variableOf[k] = j;
+  std::vector<sym::Expr> stack;
+  auto push = [&](sym::Expr e) {
+    if (e->symbolMask && seen.insert(e)) stack.push_back(e);
+  };
+  for (int32_t i : rows) push(dae.equations[i].residual);
+  while (!stack.empty()) {
+    sym::Expr n = stack.back();
+    stack.pop_back();
+    if (n->isSymbol() && unknowns.find(n)) out.push_back(n);
+    for (sym::Expr c : n->args) push(c);
+    for (sym::Expr c : n->exps) push(c);
   }
-};
-
-struct Entry {
-  int32_t row, column;
-  sym::Expr value;
-  int32_t templateEntry = -1;  // ≥ 0: JacobianEntries::templateEntries[templateEntry] at point `point`
-  uint32_t point = 0;
-};
-
-// Row order (stable) by counting: template entries come block by block, not in row order.
-std::vector<Entry> sortedByRow(const std::vector<Entry>& entries, size_t rows) {
-  std::vector<uint32_t> start(rows + 1, 0);
-  for (const Entry& e : entries) ++start[e.row + 1];
-  for (size_t r = 0; r < rows; ++r) start[r + 1] += start[r];
-  std::vector<Entry> sorted(entries.size());
-  for (const Entry& e : entries) sorted[start[e.row]++] = e;
-  return sorted;
+  return out;
 }
 
-// CSC order from entries that are already in row order: a stable counting sort by column.
-JacobianEntries compress(const std::vector<Entry>& entries, size_t columns, std::vector<TemplateEntry> templates) {
-  JacobianEntries J;
-  J.templateEntries = std::move(templates);
-  J.columnStarts.assign(columns + 1, 0);
-  for (const Entry& e : entries) ++J.columnStarts[e.column + 1];
-  for (size_t j = 0; j < columns; ++j) J.columnStarts[j + 1] += J.columnStarts[j];
-  std::vector<int32_t> next(J.columnStarts.begin(), J.columnStarts.end() - 1);
-  J.rowIndices.resize(entries.size());
-  J.values.resize(entries.size());
-  for (const Entry& e : entries) {
-    int32_t at = next[e.column]++;
-    J.rowIndices[at] = e.row;
-    J.values[at] = e.value;
-    if (e.templateEntry >= 0) J.templateEntries[e.templateEntry].positions[e.point] = static_cast<uint32_t>(at);
+// An entry of a scalar row before the pattern is laid out.
+struct RowEntry {
+  int32_t row, column;
+  sym::Expr value;
+};
+
+// The entries of the scalar rows, in row order.
+std::vector<RowEntry> scalarEntries(const dae::Dae& dae, sym::Context& ctx, sym::Expr cj, const UnknownSymbols& unknowns) {
+  std::vector<int32_t> rows;  // those with a residual of their own (not a template block's)
+  for (size_t i = 0; i < dae.equations.size(); ++i)
+    if (dae.equations[i].residual) rows.push_back(static_cast<int32_t>(i));
+  std::vector<sym::Expr> symbols = scalarUnknowns(dae, rows, unknowns);
+  std::vector<int32_t> variableOf;  // by position in symbols
+  SymbolSlots<uint32_t> positionOf(kNone);
+  for (sym::Expr s : symbols) {
+    positionOf.at(s->symbolId) = static_cast<uint32_t>(variableOf.size());
+    variableOf.push_back(static_cast<int32_t>(unknowns.find(s)->variable));
   }
-  return J;
+  sym::PartialDerivatives partial(ctx, symbols);
+  std::vector<sym::Expr> byPosition(symbols.size(), ctx.zero());  // the row's gradient
+  auto derivative = [&](sym::Expr s) {
+    uint32_t k = positionOf.get(s->symbolId);
+    return k == kNone ? ctx.zero() : byPosition[k];
+  };
+  sym::NodeMap<sym::Expr> timesCj;  // dF/dy' -> cj*dF/dy' (few distinct ones in a regular model)
+  auto cjTimes = [&](sym::Expr dyp) {
+    if (const sym::Expr* known = timesCj.find(dyp)) return *known;
+    sym::Expr r = ctx.mul(cj, dyp);
+    timesCj.insert(dyp, r);
+    return r;
+  };
+  std::vector<RowEntry> entries;
+  std::vector<int32_t> candidates;
+  std::vector<char> seen(dae.variables.size(), 0);
+  for (int32_t i : rows) {
+    sym::Expr f = dae.equations[i].residual;
+    std::span<const sym::Expr> gradient = partial.gradient(f);
+    std::span<const uint32_t> listed = partial.symbolsIn(f);
+    candidates.clear();
+    for (size_t k = 0; k < listed.size(); ++k) {
+      byPosition[listed[k]] = gradient[k];
+      int32_t j = variableOf[listed[k]];
+      if (!seen[j]) seen[j] = 1, candidates.push_back(j);
+    }
+    for (int32_t j : candidates) {
+      seen[j] = 0;
+      const dae::Variable& v = dae.variables[j];
+      sym::Expr d = derivative(v.y), dyp = v.yp ? derivative(v.yp) : ctx.zero();
+      if (dyp != ctx.zero()) d = ctx.add(d, cjTimes(dyp));  // d + cj*0 is d
+      if (!d->isZero()) entries.push_back({i, j, d});
+    }
+    for (uint32_t k : listed) byPosition[k] = ctx.zero();
+  }
+  return entries;
+}
+
+using ElementBase = std::pair<int, bool>;  // (variable − linear index, y') of an array's elements
+
+// The base every element of array `a` shares when all of them are consecutive unknowns of one kind
+// (as a coordinate array's elements are): found once per array, whereas several relative symbols
+// of several blocks read each array.
+std::optional<ElementBase> uniformBase(const flat::ArrayVariable& a, const UnknownSymbols& unknowns) {
+  std::optional<ElementBase> base;
+  for (size_t k = 0; k < a.elements.size(); ++k) {
+    std::optional<UnknownSymbols::Unknown> e = unknowns.find(a.elements[k]);
+    if (!e) return std::nullopt;
+    ElementBase at{static_cast<int>(e->variable) - static_cast<int>(k), e->derivative};
+    if (base && *base != at) return std::nullopt;
+    base = at;
+  }
+  return base;
 }
 
 // Where relative symbol `rel` of `block` reads: the unknown of the array element with linear index
 // 0 (possibly not an element the block reads, or not an unknown at all: only an index base) and
 // whether it is y'. Every element the block reads — its region shifted by the pattern's offsets —
 // must be the unknown base + its linear index, of one kind: the loop addresses them so.
-std::pair<int, bool> unknownsRead(const dae::TemplateBlock& block, const flat::RelativeElement& rel,
-                                  const flat::ArrayVariable& a,
-                                  const std::unordered_map<sym::Expr, std::pair<int, bool>>& unknownOf) {
-  std::optional<std::pair<int, bool>> base;
+ElementBase unknownsRead(const dae::TemplateBlock& block, const flat::RelativeElement& rel, const flat::ArrayVariable& a,
+                         const UnknownSymbols& unknowns) {
+  std::optional<ElementBase> base;
   flat::forEachPoint(block.region, [&](std::span<const long> p, size_t) {
     long k = 0;
     for (size_t d = 0; d < p.size(); ++d) k = k * a.shape[d] + (p[d] + rel.dims[d].offset - 1);
-    auto e = unknownOf.find(a.elements[static_cast<size_t>(k)]);
-    if (e == unknownOf.end()) QDOT_UNREACHABLE("a template reads an array element that is not an unknown");
-    std::pair<int, bool> at{e->second.first - static_cast<int>(k), e->second.second};
+    std::optional<UnknownSymbols::Unknown> e = unknowns.find(a.elements[static_cast<size_t>(k)]);
+    if (!e) QDOT_UNREACHABLE("a template reads an array element that is not an unknown");
+    ElementBase at{static_cast<int>(e->variable) - static_cast<int>(k), e->derivative};
     if (base && *base != at) QDOT_UNREACHABLE("a template reads array elements that are not consecutive unknowns");
     base = at;
   });
-  return base.value_or(std::pair{0, false});
+  return base.value_or(ElementBase{0, false});
 }
 
-// The entries of block b: ∂F/∂y + cj ∂F/∂y' per column pattern, then one Entry per point.
+// Per template block, its relative symbols with where they are read (every relative symbol of a
+// templated DAE is an unknown's: the pipeline keeps templates only then).
+std::vector<std::vector<TemplateOperand>> templateOperands(const dae::Dae& dae, const sym::Context& ctx,
+                                                           const UnknownSymbols& unknowns) {
+  std::vector<std::vector<TemplateOperand>> out(dae.templateBlocks.size());
+  size_t arrays = out.empty() ? 0 : dae.patterns->arrays.size();
+  std::vector<char> looked(arrays, 0);
+  std::vector<std::optional<ElementBase>> uniform(arrays);
+  for (size_t b = 0; b < out.size(); ++b) {
+    const dae::TemplateBlock& block = dae.templateBlocks[b];
+    for (sym::Expr s : ctx.freeSymbols(block.residual)) {
+      const flat::RelativeElement* rel = dae.patterns->find(s);
+      if (!rel) continue;
+      const flat::ArrayVariable& a = dae.patterns->arrays[rel->array];
+      if (!looked[rel->array]) looked[rel->array] = 1, uniform[rel->array] = uniformBase(a, unknowns);
+      auto [variable, derivative] = uniform[rel->array] ? *uniform[rel->array] : unknownsRead(block, *rel, a, unknowns);
+      long offset = 0;
+      for (size_t d = 0; d < rel->dims.size(); ++d) offset = offset * block.shape[d] + rel->dims[d].offset;
+      out[b].push_back({s, variable, derivative, offset});
+    }
+  }
+  return out;
+}
+
+// The entries of block b: ∂F/∂y + cj ∂F/∂y' per column pattern (positions are sized, not yet given).
 void templateEntries(const dae::Dae& dae, sym::Context& ctx, sym::Expr cj, size_t b, std::span<const TemplateOperand> operands,
-                     std::vector<TemplateEntry>& out, std::vector<Entry>& entries) {
+                     std::vector<TemplateEntry>& out) {
   const dae::TemplateBlock& block = dae.templateBlocks[b];
   size_t first = out.size();
   for (const TemplateOperand& op : operands) {
@@ -106,84 +178,98 @@ void templateEntries(const dae::Dae& dae, sym::Context& ctx, sym::Expr cj, size_
     if (same != out.end()) same->value = ctx.add(same->value, d);
     else out.push_back({static_cast<int>(b), d, op.variable, op.offset, {}});
   }
-  size_t points = flat::pointCount(block.region);
-  for (size_t e = first; e < out.size(); ++e) out[e].positions.resize(points);
-  flat::forEachPoint(block.region, [&](std::span<const long> p, size_t c) {
-    long at = flat::linearIndex(block.shape, p);
-    for (size_t e = first; e < out.size(); ++e)
-      entries.push_back({static_cast<int32_t>(block.firstRow + at), static_cast<int32_t>(out[e].variable + at + out[e].offset),
-                         nullptr, static_cast<int32_t>(e), static_cast<uint32_t>(c)});
-  });
+  for (size_t e = first; e < out.size(); ++e) out[e].positions.resize(flat::pointCount(block.region));
 }
+
+// The CSC pattern: rowIndices ascending within each column, so the entries are placed row by row.
+// A template block's row at linear index `at` of its array has, per entry e, column
+// e.variable + at + e.offset; nothing per nonzero is kept but the CSC arrays themselves.
+class PatternLayout {
+ public:
+  PatternLayout(const dae::Dae& dae, JacobianEntries& J) : dae_(dae), J_(J), blockOf_(dae.equations.size(), -1) {
+    entriesOf_.assign(dae.templateBlocks.size() + 1, 0);
+    for (const TemplateEntry& e : J.templateEntries) ++entriesOf_[e.block + 1];
+    for (size_t b = 0; b < dae.templateBlocks.size(); ++b) entriesOf_[b + 1] += entriesOf_[b];
+    for (size_t b = 0; b < dae.templateBlocks.size(); ++b) {
+      const dae::TemplateBlock& block = dae.templateBlocks[b];
+      flat::forEachPoint(block.region, [&](std::span<const long> p, size_t) {
+        blockOf_[block.firstRow + flat::linearIndex(block.shape, p)] = static_cast<int32_t>(b);
+      });
+    }
+  }
+
+  // The scalar rows' entries (in row order) are placed with the template rows'.
+  void run(const std::vector<RowEntry>& scalar) {
+    countColumns(scalar);
+    std::vector<int32_t> next(J_.columnStarts.begin(), J_.columnStarts.end() - 1);
+    J_.rowIndices.resize(static_cast<size_t>(J_.columnStarts.back()));
+    std::vector<uint32_t> point(dae_.templateBlocks.size(), 0);  // per block: the point of its next row
+    auto place = [&](int32_t row, int32_t column) {
+      int32_t at = next[column]++;
+      J_.rowIndices[at] = row;
+      return static_cast<uint32_t>(at);
+    };
+    std::vector<uint32_t> position(scalar.size());  // of scalar[k]
+    size_t s = 0;
+    for (int32_t row = 0; row < static_cast<int32_t>(blockOf_.size()); ++row) {
+      int32_t b = blockOf_[row];
+      if (b < 0) {
+        for (; s < scalar.size() && scalar[s].row == row; ++s) position[s] = place(row, scalar[s].column);
+        continue;
+      }
+      uint32_t c = point[b]++;
+      long at = row - dae_.templateBlocks[b].firstRow;
+      for (size_t e = entriesOf_[b]; e < entriesOf_[b + 1]; ++e) {
+        TemplateEntry& t = J_.templateEntries[e];
+        t.positions[c] = place(row, static_cast<int32_t>(t.variable + at + t.offset));
+      }
+    }
+    J_.scalarEntries = inPositionOrder(scalar, position);
+  }
+
+ private:
+  void countColumns(const std::vector<RowEntry>& scalar) {
+    std::vector<int32_t>& starts = J_.columnStarts;
+    starts.assign(dae_.variables.size() + 1, 0);
+    for (const RowEntry& e : scalar) ++starts[e.column + 1];
+    for (size_t b = 0; b < dae_.templateBlocks.size(); ++b) {
+      const dae::TemplateBlock& block = dae_.templateBlocks[b];
+      flat::forEachPoint(block.region, [&](std::span<const long> p, size_t) {
+        long at = flat::linearIndex(block.shape, p);
+        for (size_t e = entriesOf_[b]; e < entriesOf_[b + 1]; ++e) {
+          const TemplateEntry& t = J_.templateEntries[e];
+          ++starts[t.variable + at + t.offset + 1];
+        }
+      });
+    }
+    for (size_t j = 0; j + 1 < starts.size(); ++j) starts[j + 1] += starts[j];
+  }
+
+  // Position order is column order, rows ascending: a stable counting sort of the row-ordered list.
+  std::vector<ScalarEntry> inPositionOrder(const std::vector<RowEntry>& scalar, const std::vector<uint32_t>& position) const {
+    std::vector<uint32_t> start(dae_.variables.size() + 1, 0);
+    for (const RowEntry& e : scalar) ++start[e.column + 1];
+    for (size_t j = 0; j + 1 < start.size(); ++j) start[j + 1] += start[j];
+    std::vector<ScalarEntry> sorted(scalar.size());
+    for (size_t k = 0; k < scalar.size(); ++k) sorted[start[scalar[k].column]++] = {position[k], scalar[k].row, scalar[k].value};
+    return sorted;
+  }
+
+  const dae::Dae& dae_;
+  JacobianEntries& J_;
+  std::vector<int32_t> blockOf_;    // per row: the template block serving it, or -1 (a scalar row)
+  std::vector<size_t> entriesOf_;  // block b's entries: templateEntries[entriesOf_[b], entriesOf_[b + 1])
+};
 
 }  // namespace
 
-JacobianEntries differentiate(const dae::Dae& dae, sym::Context& ctx, sym::Expr cj) {
-  size_t n = dae.variables.size();
-  Unknowns unknowns(dae);
-  sym::PartialDerivatives partial(ctx, unknowns.symbols);
-  std::vector<sym::Expr> byPosition(unknowns.symbols.size(), ctx.zero());  // the row's gradient
-  auto derivative = [&](sym::Expr s) { return byPosition[unknowns.positionOf[s->symbolId]]; };
-  sym::NodeMap<sym::Expr> timesCj;  // dF/dy' -> cj*dF/dy' (few distinct ones in a regular model)
-  auto cjTimes = [&](sym::Expr dyp) {
-    if (const sym::Expr* known = timesCj.find(dyp)) return *known;
-    sym::Expr r = ctx.mul(cj, dyp);
-    timesCj.insert(dyp, r);
-    return r;
-  };
-  std::vector<Entry> entries;
-  std::vector<int32_t> candidates;
-  std::vector<char> seen(n, 0);
-  for (size_t i = 0; i < dae.equations.size(); ++i) {
-    sym::Expr f = dae.equations[i].residual;
-    if (!f) continue;  // a template block's row
-    std::span<const sym::Expr> gradient = partial.gradient(f);
-    std::span<const uint32_t> symbols = partial.symbolsIn(f);
-    candidates.clear();
-    for (size_t k = 0; k < symbols.size(); ++k) {
-      byPosition[symbols[k]] = gradient[k];
-      int32_t j = unknowns.variableOf[symbols[k]];
-      if (!seen[j]) seen[j] = 1, candidates.push_back(j);
-    }
-    for (int32_t j : candidates) {
-      seen[j] = 0;
-      const dae::Variable& v = dae.variables[j];
-      sym::Expr d = derivative(v.y), dyp = v.yp ? derivative(v.yp) : ctx.zero();
-      if (dyp != ctx.zero()) d = ctx.add(d, cjTimes(dyp));  // d + cj*0 is d
-      if (!d->isZero()) entries.push_back({static_cast<int32_t>(i), j, d});
-    }
-    for (uint32_t k : symbols) byPosition[k] = ctx.zero();
-  }
-  std::vector<TemplateEntry> templates;
-  std::vector<std::vector<TemplateOperand>> operands = templateOperands(dae, ctx);
-  for (size_t b = 0; b < dae.templateBlocks.size(); ++b) templateEntries(dae, ctx, cj, b, operands[b], templates, entries);
-  if (!templates.empty()) entries = sortedByRow(entries, dae.equations.size());
-  JacobianEntries J = compress(entries, n, std::move(templates));
-  J.templateOperands = std::move(operands);
+JacobianEntries differentiate(const dae::Dae& dae, const UnknownSymbols& unknowns, sym::Context& ctx, sym::Expr cj) {
+  std::vector<RowEntry> scalar = scalarEntries(dae, ctx, cj, unknowns);
+  JacobianEntries J;
+  J.templateOperands = templateOperands(dae, ctx, unknowns);
+  for (size_t b = 0; b < dae.templateBlocks.size(); ++b) templateEntries(dae, ctx, cj, b, J.templateOperands[b], J.templateEntries);
+  PatternLayout(dae, J).run(scalar);
   return J;
-}
-
-std::vector<std::vector<TemplateOperand>> templateOperands(const dae::Dae& dae, const sym::Context& ctx) {
-  std::vector<std::vector<TemplateOperand>> out(dae.templateBlocks.size());
-  if (out.empty()) return out;
-  std::unordered_map<sym::Expr, std::pair<int, bool>> unknownOf;  // element symbol → variable, is y'
-  unknownOf.reserve(2 * dae.variables.size());
-  for (int j = 0; j < static_cast<int>(dae.variables.size()); ++j) {
-    unknownOf.emplace(dae.variables[j].y, std::pair{j, false});
-    if (dae.variables[j].yp) unknownOf.emplace(dae.variables[j].yp, std::pair{j, true});
-  }
-  for (size_t b = 0; b < out.size(); ++b) {
-    const dae::TemplateBlock& block = dae.templateBlocks[b];
-    for (sym::Expr s : ctx.freeSymbols(block.residual)) {
-      const flat::RelativeElement* rel = dae.patterns->find(s);
-      if (!rel) continue;
-      auto [variable, derivative] = unknownsRead(block, *rel, dae.patterns->arrays[rel->array], unknownOf);
-      long offset = 0;
-      for (size_t d = 0; d < rel->dims.size(); ++d) offset = offset * block.shape[d] + rel->dims[d].offset;
-      out[b].push_back({s, variable, derivative, offset});
-    }
-  }
-  return out;
 }
 
 }  // namespace qdot::kernel

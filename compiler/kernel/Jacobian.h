@@ -4,6 +4,7 @@
 #pragma once
 
 #include "dae/Dae.h"
+#include "kernel/Unknowns.h"
 
 namespace qdot::kernel {
 
@@ -27,20 +28,25 @@ struct TemplateEntry {
   std::vector<uint32_t> positions;
 };
 
+/// One entry of a row that is not a template's: its CSC position, its row and its value.
+struct ScalarEntry {
+  uint32_t position = 0;
+  int32_t row = 0;
+  sym::Expr value = nullptr;  ///< uses the symbol cj
+};
+
 struct JacobianEntries {
   std::vector<int32_t> columnStarts;  ///< [nVariables + 1]
   std::vector<int32_t> rowIndices;    ///< ascending within each column
-  std::vector<sym::Expr> values;      ///< one expression per nonzero, in CSC order (uses the symbol cj); null where a template entry writes
+  /// The entries of scalar rows, ascending position; the other positions are templateEntries'.
+  std::vector<ScalarEntry> scalarEntries;
   std::vector<TemplateEntry> templateEntries;
   std::vector<std::vector<TemplateOperand>> templateOperands;  ///< per template block
 };
 
-/// Per template block, its relative symbols with where they are read (every relative symbol of a
-/// templated DAE is an unknown's: the pipeline keeps templates only then).
-std::vector<std::vector<TemplateOperand>> templateOperands(const dae::Dae& dae, const sym::Context& ctx);
-
 /// Differentiates every residual with respect to the variables it mentions: one sparse forward pass
-/// (sym::PartialDerivatives), O(Σ over the residuals' nodes of the unknowns each contains).
-JacobianEntries differentiate(const dae::Dae& dae, sym::Context& ctx, sym::Expr cj);
+/// (sym::PartialDerivatives) over the scalar rows, O(Σ over their nodes of the unknowns each
+/// contains), and one derivative per column pattern of each template block. `unknowns`: dae's.
+JacobianEntries differentiate(const dae::Dae& dae, const UnknownSymbols& unknowns, sym::Context& ctx, sym::Expr cj);
 
 }  // namespace qdot::kernel

@@ -47,6 +47,7 @@ class Builder {
   DiagnosticEngine& diags_;
   KernelModule m_;
   std::vector<uint32_t> equationSource_;
+  std::vector<uint32_t> scalarRows_;  ///< the DAE's rows with a residual of their own (not a template block's)
 
   uint32_t addSource(std::string label, SourceRange range, std::string text = {}) {
     m_.sources.push_back({std::move(label), range, shorten(std::move(text))});
@@ -74,6 +75,9 @@ class Builder {
   void describeModel() {
     ModelDescription& d = m_.description;
     d.name = dae_.name;
+    d.variableNames.reserve(dae_.variables.size());
+    d.isDifferential.reserve(dae_.variables.size());
+    d.fixed.reserve(dae_.variables.size());
     for (const auto& v : dae_.variables) {
       d.variableNames.push_back(v.name);
       d.isDifferential.push_back(v.kind == dae::VarKind::State);
@@ -143,6 +147,7 @@ class Builder {
     for (size_t i = 0; i < dae_.equations.size(); ++i) {
       const auto& e = dae_.equations[i];
       equationSource_.push_back(e.residual ? addSource(equationLabel(i, e), e.origin.range, equationText(e)) : UINT32_MAX);
+      if (e.residual) scalarRows_.push_back(static_cast<uint32_t>(i));
     }
   }
 
@@ -151,12 +156,15 @@ class Builder {
     if (dae_.time) b.bindLoad(dae_.time, Op::LoadTime, 0);
     for (uint32_t k = 0; k < dae_.parameters.size(); ++k) b.bindLoad(dae_.parameters[k].symbol, Op::LoadP, k);
     if (cj) b.bindLoad(cj, Op::LoadCj, 0);
-    if (!variables) return;
-    for (uint32_t j = 0; j < dae_.variables.size(); ++j) {
-      b.bindLoad(dae_.variables[j].y, Op::LoadY, j);
-      if (dae_.variables[j].yp) b.bindLoad(dae_.variables[j].yp, Op::LoadYp, j);
-    }
+    if (variables) b.bindUnknowns(unknowns());
   }
+
+  // The DAE's y and y' by symbol, built on first use and shared by every program and the Jacobian.
+  const UnknownSymbols& unknowns() {
+    if (!unknowns_) unknowns_.emplace(dae_);
+    return *unknowns_;
+  }
+  std::optional<UnknownSymbols> unknowns_;
 
   // A symbol no input binds: at the source that used it (the model's line if that has no location).
   void reportUnbound(const ProgramBuilder& b, const std::string& where, const char* help) {
@@ -234,9 +242,9 @@ class Builder {
   std::vector<dae::StartUse> startUse_;                   ///< per variable: what its start value is
   std::vector<dae::Equation> initialRows_;                ///< initial equations that are not start values
 
-  struct Start {
-    Expr y0 = nullptr, yp0 = nullptr;
-    uint32_t source = UINT32_MAX, derivativeSource = UINT32_MAX;
+  struct Starts {
+    std::vector<Expr> values;       ///< per variable: y0 (null: 0)
+    std::vector<uint32_t> sources;  ///< per variable: the source of its value (UINT32_MAX: none)
   };
 
   bool overParameters(Expr e) const {
@@ -249,7 +257,7 @@ class Builder {
   }
 
   // `v = expr` or `der(x) = expr` (either side) with expr over parameters and time.
-  bool applyInitialEquation(size_t i, std::vector<Start>& starts) {
+  bool applyInitialEquation(size_t i, Starts& starts) {
     const dae::Equation& e = dae_.initialEquations[i];
     if (!e.lhs || !e.rhs) return false;
     for (int side = 0; side < 2; ++side) {
@@ -260,7 +268,7 @@ class Builder {
         if (v.y != target) continue;  // a derivative's value is a condition of the initialization system
         if (!acceptInitialEquation(e, i, j, true)) return true;  // reported
         uint32_t src = addSource("initial equation " + std::to_string(i + 1), e.origin.range, equationText(e));
-        starts[j].y0 = value, starts[j].source = src, m_.description.fixed[j] = kFixedAsWritten;
+        starts.values[j] = value, starts.sources[j] = src, m_.description.fixed[j] = kFixedAsWritten;
         startUse_[j] = dae::StartUse::Required;
         return true;
       }
@@ -292,23 +300,24 @@ class Builder {
     return true;
   }
 
-  std::vector<Start> collectStarts() {
-    std::vector<Start> starts(dae_.variables.size());
-    std::vector<Expr> declared;
-    for (const auto& v : dae_.variables) declared.push_back(v.declaration.start);
-    std::vector<char> looped = inRuns(numberRuns(declared), declared.size());
-    for (size_t j = 0; j < dae_.variables.size(); ++j) {
-      const auto& v = dae_.variables[j];
-      starts[j].y0 = v.declaration.start;
-      if (v.declaration.start && !looped[j]) starts[j].source = addSource("start value of " + v.name, v.declaration.declRange);
-    }
-    startUse_.resize(dae_.variables.size());
-    for (size_t j = 0; j < dae_.variables.size(); ++j) {  // as written (fixed = …), else the default
+  // One pass over the variables (a large model has millions): declared starts and their use.
+  Starts collectStarts() {
+    size_t n = dae_.variables.size();
+    Starts starts;
+    starts.values.reserve(n);
+    startUse_.reserve(n);
+    for (size_t j = 0; j < n; ++j) {
       const flat::Variable& d = dae_.variables[j].declaration;
-      startUse_[j] = d.fixedGiven ? (d.fixed ? dae::StartUse::Required : dae::StartUse::Guess)
-                     : m_.description.fixed[j] ? dae::StartUse::Default
-                                               : dae::StartUse::Guess;
+      starts.values.push_back(d.start);
+      startUse_.push_back(d.fixedGiven ? (d.fixed ? dae::StartUse::Required : dae::StartUse::Guess)  // as written
+                          : m_.description.fixed[j] ? dae::StartUse::Default
+                                                    : dae::StartUse::Guess);
     }
+    starts.sources.assign(n, UINT32_MAX);
+    std::vector<char> looped = inRuns(numberRuns(starts.values), n);
+    for (size_t j = 0; j < n; ++j)
+      if (starts.values[j] && !looped[j])
+        starts.sources[j] = addSource("start value of " + dae_.variables[j].name, dae_.variables[j].declaration.declRange);
     for (size_t i = 0; i < dae_.initialEquations.size(); ++i)
       if (!applyInitialEquation(i, starts)) initialRows_.push_back(dae_.initialEquations[i]);
     if (!initialRows_.empty()) planInitialRows();
@@ -329,7 +338,7 @@ class Builder {
   // out = [y0 (n), yp0 (n), nominal (n)]; stores of a plain 0 serve no source. Runs of numbers
   // (a large array's starts, its zero derivatives and nominals) are stored by loops.
   void buildInitialValues() {
-    std::vector<Start> starts = collectStarts();
+    Starts starts = collectStarts();
     ProgramBuilder b(programName(ModelProgram::InitialValues));
     bindInputs(b, false);
     auto n = static_cast<uint32_t>(dae_.variables.size());
@@ -337,11 +346,11 @@ class Builder {
       b.setSource(value ? source : UINT32_MAX);
       b.store(slot, value ? b.lower(value) : b.constant(0.0));
     };
-    std::vector<Expr> y0, yp0, nominal;
-    for (const Start& st : starts) y0.push_back(st.y0), yp0.push_back(st.yp0);
+    std::vector<Expr> derivatives(n, nullptr), nominal;  // y'0 = 0: no start value gives one
+    nominal.reserve(n);
     for (const auto& v : dae_.variables) nominal.push_back(v.declaration.nominal);
-    storeSection(b, 0, y0, [&](uint32_t j) { store(j, starts[j].y0, starts[j].source); });
-    storeSection(b, n, yp0, [&](uint32_t j) { store(n + j, starts[j].yp0, starts[j].derivativeSource); });
+    storeSection(b, 0, starts.values, [&](uint32_t j) { store(j, starts.values[j], starts.sources[j]); });
+    storeSection(b, n, derivatives, [&](uint32_t j) { store(n + j, nullptr, UINT32_MAX); });
     storeSection(b, 2 * n, nominal, [&](uint32_t j) {
       const auto& v = dae_.variables[j];
       store(2 * n + j, nominal[j], nominal[j] ? addSource("nominal value of " + v.name, v.declaration.declRange) : UINT32_MAX);
@@ -418,13 +427,14 @@ class Builder {
 
   void buildResidualAndJacobian() {
     Expr cj = ctx_.symbol("$cj");
-    JacobianEntries jac = initialRows_.empty() ? differentiate(dae_, ctx_, cj) : differentiate(withInitialRows(), ctx_, cj);
-    m_.description.jacobianColumnStarts = jac.columnStarts;
-    m_.description.jacobianRowIndices = jac.rowIndices;
+    JacobianEntries jac = initialRows_.empty() ? differentiate(dae_, unknowns(), ctx_, cj)
+                                                : differentiate(withInitialRows(), unknowns(), ctx_, cj);
+    auto nonzeros = static_cast<uint32_t>(jac.rowIndices.size());
+    m_.description.jacobianColumnStarts = std::move(jac.columnStarts);
+    m_.description.jacobianRowIndices = std::move(jac.rowIndices);
     std::vector<Expr> roots;
-    std::vector<uint32_t> rows, entries;  // the rows and Jacobian entries the roots are (template ones are not)
-    for (uint32_t i = 0; i < dae_.equations.size(); ++i)
-      if (dae_.equations[i].residual) roots.push_back(dae_.equations[i].residual), rows.push_back(i);
+    std::vector<uint32_t> rows;  // the rows the roots are (template ones are not)
+    for (uint32_t i : scalarRows_) roots.push_back(dae_.equations[i].residual), rows.push_back(i);
     for (size_t k = 0; k < initialRows_.size(); ++k) {  // after every DAE row: rows used only at t0
       const auto& e = initialRows_[k];
       auto row = static_cast<int32_t>(dae_.equations.size() + k);
@@ -434,8 +444,7 @@ class Builder {
       roots.push_back(e.residual), rows.push_back(static_cast<uint32_t>(row));
     }
     size_t rowRoots = roots.size();
-    for (uint32_t k = 0; k < jac.values.size(); ++k)
-      if (jac.values[k]) roots.push_back(jac.values[k]), entries.push_back(k);
+    for (const ScalarEntry& e : jac.scalarEntries) roots.push_back(e.value);
     roots = sym::expandAngleDifferences(ctx_, roots);  // sin/cos of each angle once, shared
     sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, roots, "$t");
     m_.sharedTemporaries = cse.temporaries.size();
@@ -452,25 +461,39 @@ class Builder {
     ProgramBuilder jb(programName(ModelProgram::Jacobian));
     bindInputs(jb, true, cj);
     for (const auto& [t, value] : cse.temporaries) jb.bindTemporary(t, value);
-    for (size_t k = 0; k < entries.size(); ++k) {
-      jb.setSource(equationSource_[jac.rowIndices[entries[k]]]);
-      jb.store(entries[k], jb.lower(cse.outputs[rowRoots + k]));
+    for (size_t k = 0; k < jac.scalarEntries.size(); ++k) {
+      const ScalarEntry& e = jac.scalarEntries[k];
+      jb.setSource(equationSource_[e.row]);
+      jb.store(e.position, jb.lower(cse.outputs[rowRoots + k]));
     }
+    jb.reserveIndexTable(jacobianIndexTableSize(jac));
     for (size_t b = 0; b < dae_.templateBlocks.size(); ++b) emitBlock(jb, b, jac, true);
-    m_.program(ModelProgram::Jacobian) = jb.finish(static_cast<uint32_t>(jac.values.size()));
+    m_.program(ModelProgram::Jacobian) = jb.finish(nonzeros);
+  }
+
+  // What the Jacobian's blocks append to its index table: every template entry's CSC positions
+  // and the offsets of each block that loops over a table (more than one dimension).
+  size_t jacobianIndexTableSize(const JacobianEntries& jac) const {
+    size_t n = 0;
+    std::vector<char> hasEntries(dae_.templateBlocks.size(), 0);
+    for (const TemplateEntry& e : jac.templateEntries) n += e.positions.size(), hasEntries[e.block] = 1;
+    for (size_t b = 0; b < hasEntries.size(); ++b)
+      if (hasEntries[b] && dae_.templateBlocks[b].region.size() > 1) n += flat::pointCount(dae_.templateBlocks[b].region);
+    return n;
   }
 
   // --- template blocks (issue 15, docs/loops.md) ---------------------------------------------------
 
   // One loop over block b's region: its rows (residual) or its Jacobian entries, each stored at its
   // CSC position through an index table. The block's own CSE; temporaries that read no relative
-  // symbol (parameters only) are computed once before the loop.
-  void emitBlock(ProgramBuilder& b, size_t k, const JacobianEntries& jac, bool jacobian) {
+  // symbol (parameters only) are computed once before the loop. The entries' positions move to the
+  // program's index table (freed here: a large model has millions).
+  void emitBlock(ProgramBuilder& b, size_t k, JacobianEntries& jac, bool jacobian) {
     const dae::TemplateBlock& block = dae_.templateBlocks[k];
     std::vector<Expr> roots;
-    std::vector<const TemplateEntry*> entries;
+    std::vector<TemplateEntry*> entries;
     if (!jacobian) roots.push_back(block.residual);
-    for (const TemplateEntry& e : jac.templateEntries)
+    for (TemplateEntry& e : jac.templateEntries)
       if (jacobian && e.block == static_cast<int>(k)) roots.push_back(e.value), entries.push_back(&e);
     if (roots.empty()) return;
     sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, roots, "$b" + std::to_string(k) + (jacobian ? "j" : "r"));
@@ -486,7 +509,10 @@ class Builder {
     for (Expr t : invariantTemporaries(cse, operands)) b.lower(t);
     b.beginLoop(loopOver(b, block, base));
     if (!jacobian) b.storeLooped(static_cast<uint32_t>(block.firstRow + base), b.lower(cse.outputs[0]));
-    for (size_t e = 0; e < entries.size(); ++e) b.storeIndexed(b.appendIndexTable(entries[e]->positions), b.lower(cse.outputs[e]));
+    for (size_t e = 0; e < entries.size(); ++e) {
+      b.storeIndexed(b.appendIndexTable(entries[e]->positions), b.lower(cse.outputs[e]));
+      std::vector<uint32_t>().swap(entries[e]->positions);
+    }
     b.endLoop();
   }
 

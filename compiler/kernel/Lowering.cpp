@@ -91,7 +91,8 @@ const uint32_t* ProgramBuilder::known(sym::Expr e) const {
     const uint32_t* r = memo_.find(e);
     return r ? r : bodyMemo_.find(e);
   }
-  return e->symbolId < symbolRegs_.size() && symbolRegs_[e->symbolId] != kNone ? &symbolRegs_[e->symbolId] : nullptr;
+  const uint32_t* r = symbolRegs_.find(e->symbolId);
+  return r && *r != kNone ? r : nullptr;
 }
 
 void ProgramBuilder::remember(sym::Expr e, uint32_t reg) {
@@ -101,7 +102,7 @@ void ProgramBuilder::remember(sym::Expr e, uint32_t reg) {
 }
 
 void ProgramBuilder::setSymbolRegister(sym::Expr symbol, uint32_t reg) {
-  uint32_t& r = slot(symbolRegs_, symbol, kNone);
+  uint32_t& r = symbolRegs_.at(symbol->symbolId);
   if (inLoop_) bodySymbols_.emplace_back(symbol->symbolId, r);
   r = reg;
 }
@@ -119,7 +120,7 @@ void ProgramBuilder::endLoop() {
   QDOT_ASSERT(inLoop_, "endLoop without beginLoop");
   emit(Op::LoopEnd, 0, 0, 0, static_cast<uint32_t>(program_.loops.size() - 1));
   inLoop_ = false;
-  for (auto it = bodySymbols_.rbegin(); it != bodySymbols_.rend(); ++it) symbolRegs_[it->first] = it->second;
+  for (auto it = bodySymbols_.rbegin(); it != bodySymbols_.rend(); ++it) symbolRegs_.at(it->first) = it->second;
   bodySymbols_.clear();
   bodyMemo_.clear();
   bodyConstants_.clear();
@@ -135,7 +136,7 @@ uint32_t ProgramBuilder::appendIndexTable(std::span<const uint32_t> values) {
 // temporary's value), or nullptr when there is none left.
 sym::Expr ProgramBuilder::nextChild(Frame& f) const {
   sym::Expr e = f.node;
-  if (e->isSymbol()) return f.next++ == 0 ? find(temporaries_, e, sym::Expr{nullptr}) : nullptr;
+  if (e->isSymbol()) return f.next++ == 0 ? temporaries_.get(e->symbolId) : nullptr;
   while (f.next < e->args.size() + e->exps.size()) {
     size_t i = f.next++;
     sym::Expr c = e->args.data()[i];  // args, then exps (one array)
@@ -179,8 +180,10 @@ uint32_t ProgramBuilder::emitNode(sym::Expr e) {
 }
 
 uint32_t ProgramBuilder::emitSymbol(sym::Expr e) {
-  if (sym::Expr t = find(temporaries_, e, sym::Expr{nullptr})) return reg(t);
-  if (Load l = find(loads_, e, kNoLoad); l.second != kNone) return emit(l.first, 0, 0, 0, l.second);
+  if (sym::Expr t = temporaries_.get(e->symbolId)) return reg(t);
+  if (Load l = loads_.get(e->symbolId); l.second != kNone) return emit(l.first, 0, 0, 0, l.second);
+  if (auto u = unknowns_ ? unknowns_->find(e) : std::nullopt)
+    return emit(u->derivative ? Op::LoadYp : Op::LoadY, 0, 0, 0, u->variable);
   unbound_.push_back({e, source_});
   return constant(std::numeric_limits<double>::quiet_NaN());
 }

@@ -9,6 +9,8 @@
 #include <unordered_map>
 
 #include "kernel/Kernel.h"
+#include "kernel/SymbolSlots.h"
+#include "kernel/Unknowns.h"
 #include "symbolic/NodeMap.h"
 
 namespace qdot::kernel {
@@ -20,7 +22,10 @@ class ProgramBuilder {
   explicit ProgramBuilder(std::string name) { program_.name = std::move(name); }
 
   /// `symbol` reads input `index` with a load opcode (emitted when first used).
-  void bindLoad(sym::Expr symbol, Op load, uint32_t index) { slot(loads_, symbol, kNoLoad) = {load, index}; }
+  void bindLoad(sym::Expr symbol, Op load, uint32_t index) { loads_.at(symbol->symbolId) = {load, index}; }
+  /// Each unknown's y and y' read input y[j] and yp[j] (Op::LoadY, Op::LoadYp), j its variable;
+  /// bindLoad wins over this. The table is shared, not copied: it must outlive the builder.
+  void bindUnknowns(const UnknownSymbols& unknowns) { unknowns_ = &unknowns; }
   /// `symbol` reads y[index + L] (Op::LoadYLooped) or yp[index + L] (Op::LoadYpLooped) inside loops.
   void bindLoopedLoad(sym::Expr symbol, Op load, uint32_t index) { bindLoad(symbol, load, index); }
   /// `symbol` is the loop offset L as a number (ldidx).
@@ -28,7 +33,7 @@ class ProgramBuilder {
   /// `symbol` is the value already in register `reg` (inside a loop body: until endLoop).
   void bindRegister(sym::Expr symbol, uint32_t reg) { setSymbolRegister(symbol, reg); }
   /// `symbol` is a CSE temporary standing for `value` (lowered when first used).
-  void bindTemporary(sym::Expr symbol, sym::Expr value) { slot(temporaries_, symbol, sym::Expr{nullptr}) = value; }
+  void bindTemporary(sym::Expr symbol, sym::Expr value) { temporaries_.at(symbol->symbolId) = value; }
 
   /// Instructions emitted from now on serve source `s`.
   void setSource(uint32_t s) { source_ = s; }
@@ -51,6 +56,8 @@ class ProgramBuilder {
   void storeIndexed(uint32_t tableBase, uint32_t reg) { emit(Op::StoreIndexed, reg, 0, 0, tableBase); }
   /// Appends to the program's indexTable; returns the base index.
   uint32_t appendIndexTable(std::span<const uint32_t> values);
+  /// Room for `count` more indexTable entries (a large model appends millions).
+  void reserveIndexTable(size_t count) { program_.indexTable.reserve(program_.indexTable.size() + count); }
 
   /// A symbol met that has no binding (lowered as NaN), and the source whose code first used it.
   struct UnboundUse {
@@ -63,19 +70,10 @@ class ProgramBuilder {
 
  private:
   // What a symbol stands for (a temporary wins over a load) and its register once known, by symbol
-  // id: a model binds every y and y' of the DAE, hundreds of thousands of them for large models,
-  // and symbols are the most used nodes. Separate arrays: the register, looked up most, stays dense.
+  // id (symbols are the most used nodes) in pages: a program of a large model reads few of its
+  // millions of symbols. Separate tables: the register, looked up most, stays compact.
   using Load = std::pair<Op, uint32_t>;  // index kNone: no load
   static constexpr Load kNoLoad{Op::Ret, kNone};
-  template <class T>
-  static T& slot(std::vector<T>& bySymbol, sym::Expr symbol, T none) {
-    if (bySymbol.size() <= symbol->symbolId) bySymbol.resize(symbol->symbolId + 1, none);
-    return bySymbol[symbol->symbolId];
-  }
-  template <class T>
-  static T find(const std::vector<T>& bySymbol, sym::Expr symbol, T none) {
-    return symbol->symbolId < bySymbol.size() ? bySymbol[symbol->symbolId] : none;
-  }
   struct Frame {
     sym::Expr node;
     size_t next;  // next child to look at
@@ -97,9 +95,10 @@ class ProgramBuilder {
   Program program_;
   uint32_t source_ = UINT32_MAX;
   sym::NodeMap<uint32_t> memo_;                       // node (not a leaf) -> register
-  std::vector<uint32_t> symbolRegs_;                  // by symbolId; kNone: not lowered yet
-  std::vector<sym::Expr> temporaries_;                // by symbolId
-  std::vector<Load> loads_;                           // by symbolId
+  SymbolSlots<uint32_t> symbolRegs_{kNone};           // kNone: not lowered yet
+  SymbolSlots<sym::Expr> temporaries_{nullptr};
+  SymbolSlots<Load> loads_{kNoLoad};
+  const UnknownSymbols* unknowns_ = nullptr;          // loads of y and y' not in loads_
   std::unordered_map<uint64_t, uint32_t> constants_;  // bit pattern -> register
   std::unordered_map<uint64_t, uint32_t> pool_;       // bit pattern -> index in the pool
   // The open loop body's own values, forgotten at endLoop: nodes, constants, and the symbols'

@@ -69,9 +69,10 @@ llvm::Function* declareProgramFunction(llvm::Module& m, const std::string& name,
 /// load or constant) or reloaded from its spill slot, once per part.
 class PartLowering {
  public:
-  PartLowering(const kernel::Program& p, const ProgramSplit& split, llvm::Function* f, size_t begin, size_t end)
+  PartLowering(const kernel::Program& p, const ProgramSplit& split, llvm::Function* f, size_t begin, size_t end,
+               IndexTables tables = IndexTables::Embedded)
       : prog_(p), split_(split), mod_(*f->getParent()), b_(f->getContext()), dbl_(b_.getDoubleTy()), fn_(f),
-        begin_(begin), end_(end), local_(end - begin, nullptr) {}
+        begin_(begin), end_(end), local_(end - begin, nullptr), tables_(tables) {}
 
   void emit() {
     entry_ = llvm::BasicBlock::Create(mod_.getContext(), "entry", fn_);
@@ -150,18 +151,26 @@ class PartLowering {
     b_.CreateCondBr(b_.CreateICmpULT(next, b_.getInt64(count_)), body_, after);
     b_.SetInsertPoint(after);
   }
-  // X[base + c] as an i64 (the index table: a private constant global of the module, one per program).
+  // X[base + c] as an i64: from the index table, a private constant global of the module (one per
+  // program), or the program's own table at its address (IndexTables::InPlace).
   llvm::Value* tableEntry(uint32_t base) {
     llvm::Type* i32 = b_.getInt32Ty();
-    auto* type = llvm::ArrayType::get(i32, prog_.indexTable.size());
+    llvm::Value* at = b_.CreateInBoundsGEP(i32, indexTable(), b_.CreateAdd(b_.getInt64(base), c_));
+    return b_.CreateZExt(b_.CreateLoad(i32, at), b_.getInt64Ty());
+  }
+  llvm::Value* indexTable() {
+    if (tables_ == IndexTables::InPlace) {
+      auto address = reinterpret_cast<uint64_t>(prog_.indexTable.data());
+      return llvm::ConstantExpr::getIntToPtr(b_.getInt64(address), b_.getPtrTy());
+    }
+    auto* type = llvm::ArrayType::get(b_.getInt32Ty(), prog_.indexTable.size());
     std::string name = "qdot.X." + prog_.name;
     llvm::GlobalVariable* table = mod_.getNamedGlobal(name);
     if (!table || table->getValueType() != type) {
       auto* init = llvm::ConstantDataArray::get(mod_.getContext(), llvm::ArrayRef<uint32_t>(prog_.indexTable));
       table = new llvm::GlobalVariable(mod_, type, true, llvm::GlobalValue::PrivateLinkage, init, name);
     }
-    llvm::Value* at = b_.CreateInBoundsGEP(i32, table, b_.CreateAdd(b_.getInt64(base), c_));
-    return b_.CreateZExt(b_.CreateLoad(i32, at), b_.getInt64Ty());
+    return table;
   }
   // &array[imm + L] of a looped load or store.
   llvm::Value* loopedPtr(llvm::Value* array, uint32_t imm) {
@@ -284,6 +293,7 @@ class PartLowering {
   llvm::Function* fn_;
   size_t begin_, end_;
   std::vector<llvm::Value*> local_;                       // values of [begin_, end_)
+  IndexTables tables_;
   std::unordered_map<uint32_t, llvm::Value*> imported_;  // earlier parts' values used here
   std::array<llvm::Value*, kOverridden + 1> fields_{};    // ModelCall fields loaded in this part
   llvm::BasicBlock* entry_ = nullptr;
@@ -305,11 +315,11 @@ void emitCaller(llvm::Function* entry, const std::vector<llvm::Function*>& parts
 }  // namespace
 
 void lowerParts(const kernel::Program& p, const ProgramSplit& split, uint32_t first, uint32_t last,
-                const std::string& name, llvm::Module& m, bool internal) {
+                const std::string& name, llvm::Module& m, bool internal, IndexTables tables) {
   for (uint32_t k = first; k < last; ++k) {
     llvm::Function* f = declareProgramFunction(m, partName(name, k), internal);
     if (internal) f->addFnAttr(llvm::Attribute::NoInline);
-    PartLowering(p, split, f, split.begin(k), split.end(k, p.code.size())).emit();
+    PartLowering(p, split, f, split.begin(k), split.end(k, p.code.size()), tables).emit();
   }
 }
 

@@ -126,7 +126,7 @@ class UnitCompiler {
     m.setTargetTriple(tm->getTargetTriple().str());
     for (const Segment& s : u.plan.segments) {
       const ProgramPlan& plan = plans_[programIndex(s.program)];
-      lowerParts(k_.program(s.program), plan.split, s.first, s.last, plan.name, m, false);
+      lowerParts(k_.program(s.program), plan.split, s.first, s.last, plan.name, m, false, IndexTables::InPlace);
     }
     std::string verifyErrors;
     llvm::raw_string_ostream os(verifyErrors);

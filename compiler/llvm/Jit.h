@@ -21,7 +21,8 @@ using ProgramFn = void (*)(const ModelCall* call, double* out, double* spill);
 /// Compiled code of every program; owns the LLJIT instance (and so the machine code).
 class JitSession {
  public:
-  /// Compiles `k`, or says why it cannot. Fills `stats` if given.
+  /// Compiles `k`, or says why it cannot. Fills `stats` if given. The code reads k's index tables
+  /// in place: `k` must outlive the session.
   static Result<std::unique_ptr<JitSession>> compile(const kernel::KernelModule& k, const JitOptions& options,
                                                      JitStats* stats);
   ~JitSession();

@@ -30,7 +30,7 @@ ProgramTrace traceOf(const kernel::Program& p) {
 }
 
 struct JitModel : AdaptedModel {
-  kernel::KernelModule kernels;
+  std::shared_ptr<const kernel::KernelModule> kernels;
   std::vector<bc::Location> locations;  // per kernel source, for the diagnosis
   std::unique_ptr<JitSession> session;
   mutable PerProgram<std::vector<double>> spill;
@@ -38,14 +38,14 @@ struct JitModel : AdaptedModel {
   /// Calls the compiled program (its parts in order), or interprets one that was not compiled; a
   /// non-finite result is traced on the kernel IR for lastError.
   int run(ModelProgram program, const ModelCall& c, double* out) const {
-    const kernel::Program& code = kernels.program(program);
+    const kernel::Program& code = kernels->program(program);
     double* scratch = spill[programIndex(program)].data();
     std::span<const ProgramFn> parts = session->program(program);
     if (parts.empty()) kernel::interpret(code, c, {out, code.outputCount});
     for (ProgramFn part : parts) part(&c, out, scratch);
     for (uint32_t i = 0; i < code.outputCount; ++i)
       if (!std::isfinite(out[i])) {
-        error = diagnoseNonFinite(kernels.description, locations, program, traceOf(code), c);
+        error = diagnoseNonFinite(kernels->description, locations, program, traceOf(code), c);
         return 1;
       }
     return 0;
@@ -71,16 +71,22 @@ Status validate(const kernel::KernelModule& k) {
 
 Result<ModelPtr> createJitModel(const kernel::KernelModule& k, const SourceManager& sm, const JitOptions& options,
                                 JitStats* stats) {
-  if (Status valid = validate(k); !valid) return Error{valid.error()};
-  auto session = JitSession::compile(k, options, stats);
+  return createJitModel(std::make_shared<const kernel::KernelModule>(k), sm, options, stats);
+}
+
+Result<ModelPtr> createJitModel(std::shared_ptr<const kernel::KernelModule> k, const SourceManager& sm,
+                                const JitOptions& options, JitStats* stats) {
+  if (Status valid = validate(*k); !valid) return Error{valid.error()};
+  // The model holds the kernels it was compiled from: the code reads their index tables in place.
+  auto session = JitSession::compile(*k, options, stats);
   if (!session) return Error{session.error()};
   auto m = std::make_unique<JitModel>();
-  m->kernels = k;
-  for (const kernel::Source& s : k.sources)
+  m->kernels = std::move(k);
+  for (const kernel::Source& s : m->kernels->sources)
     m->locations.push_back({s.label, kernel::describeLocation(sm, s.range), s.text});
   m->session = std::move(session).value();
   for (size_t i = 0; i < kModelProgramCount; ++i) m->spill[i].assign(m->session->spillSlots(programAt(i)), 0.0);
-  ModelAdapter<JitModel>::install(*m, m->kernels.description);
+  ModelAdapter<JitModel>::install(*m, m->kernels->description);
   return ModelPtr(m.release());
 }
 

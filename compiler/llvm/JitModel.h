@@ -3,6 +3,8 @@
 // ABI the bytecode VM implements. No LLVM type appears here; LLVM headers stay in compiler/llvm.
 #pragma once
 
+#include <memory>
+
 #include <atomic>
 #include <cstdint>
 #include <string>
@@ -76,6 +78,9 @@ struct JitStats {
 /// Fills `stats` if given.
 Result<ModelPtr> createJitModel(const kernel::KernelModule& k, const SourceManager& sm, const JitOptions& options,
                                 JitStats* stats = nullptr);
+/// The same, sharing the kernels instead of copying them (a large model's tables are large).
+Result<ModelPtr> createJitModel(std::shared_ptr<const kernel::KernelModule> k, const SourceManager& sm,
+                                const JitOptions& options, JitStats* stats = nullptr);
 
 /// The options for one simulation (qdot run): the defaults, without the invariants unless the run
 /// asks for them.

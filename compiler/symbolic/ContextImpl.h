@@ -10,6 +10,7 @@
 #include <limits>
 #include <span>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "symbolic/Arena.h"
@@ -128,7 +129,10 @@ struct Context::Impl {
   };
   std::unique_ptr<NameSlot[]> symbolsByName;  ///< open addressing over the name hashes
   size_t nameTableSize = 0;                   ///< a power of two, or 0
-  std::vector<NodeMap<Expr>> diffMemo;  ///< by symbolId: node -> derivative
+  /// By symbolId of the variable differentiated by: node -> derivative. A map, not a vector by id:
+  /// a large model differentiates by few of its millions of symbols (and the memo's references
+  /// stay valid while a derivative by another symbol is added).
+  std::unordered_map<uint32_t, NodeMap<Expr>> diffMemo;
 
   /// Returns the unique node structurally equal to `key`, creating it if new (then its operands
   /// are copied into the arena, so the key's spans may point to temporary storage). Fills the key's

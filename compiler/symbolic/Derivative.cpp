@@ -249,10 +249,8 @@ struct Partial final : Direction {
 
 Expr Context::diff(Expr e, Expr s) {
   if (!s || !s->isSymbol()) throw std::invalid_argument("diff: not a symbol");
-  auto& memos = impl_->diffMemo;
-  if (memos.size() <= s->symbolId) memos.resize(s->symbolId + 1);
   Partial along(*this, s);
-  return differentiate(*this, along, memos[s->symbolId], e);
+  return differentiate(*this, along, impl_->diffMemo[s->symbolId], e);
 }
 
 // --- DirectionalDerivative -------------------------------------------------------------------------

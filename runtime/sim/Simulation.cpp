@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <set>
 
 #include "arkode/ArkodeSession.h"
@@ -179,21 +180,38 @@ std::vector<Column> defaultColumns(const QdotModel& model, bool invariants) {
   return columns;
 }
 
+// Looks the names up without copying every column (a model of 10^6 unknowns asked for x[1]);
+// the list of every name is made only for the message when a name is unknown.
 std::vector<Column> selectColumns(const QdotModel& model, const std::vector<std::string>& names, bool invariants) {
-  std::vector<Column> all = defaultColumns(model, true);
-  std::vector<std::string_view> candidates;
-  for (const Column& c : all)
-    candidates.push_back(c.name);
+  struct Source {
+    Column::Source source;
+    const char* const* names;
+    uint32_t count;
+  };
+  const Source sources[] = {{Column::Source::Variable, model.variableNames, model.nVariables},
+                            {Column::Source::Output, model.outputNames, model.nOutputs},
+                            {Column::Source::Invariant, model.invariantNames, model.nInvariants}};
+  auto find = [&](std::string_view name) -> std::optional<Column> {
+    for (const Source& s : sources)
+      for (uint32_t i = 0; i < s.count; ++i)
+        if (s.names && s.names[i] && name == s.names[i]) return Column{s.source, i, std::string(name)};
+    return std::nullopt;
+  };
   std::vector<Column> chosen;
   std::set<std::string> seen;
   for (const std::string& name : names) {
-    auto it = std::find_if(all.begin(), all.end(), [&](const Column& c) { return c.name == name; });
-    if (it == all.end()) throw UsageError(unknownNameMessage("output column", name, candidates));
+    std::optional<Column> column = find(name);
+    if (!column) {
+      std::vector<Column> all = defaultColumns(model, true);
+      std::vector<std::string_view> candidates;
+      for (const Column& c : all) candidates.push_back(c.name);
+      throw UsageError(unknownNameMessage("output column", name, candidates));
+    }
     if (!seen.insert(name).second) throw UsageError(fmt::format("output column '{}' is selected twice", name));
-    chosen.push_back(*it);
+    chosen.push_back(*column);
   }
   if (invariants)
-    for (const Column& c : all)
+    for (const Column& c : defaultColumns(model, true))
       if (c.source == Column::Source::Invariant && seen.insert(c.name).second) chosen.push_back(c);
   return chosen;
 }

@@ -1,0 +1,270 @@
+// `for` equations kept as templates (issue 15, docs/loops.md, dae/TemplateOde.h): a model whose
+// equations are an explicit ODE der(x) = f(x, p, t) keeps each `for` equation `der(x[i]) = …` as one
+// template and one loop, and its kernels compute what the model's scalar kernels compute (residual
+// and Jacobian at random states, to rounding). A model that is not such an ODE, or a loop that is
+// not such a template, compiles exactly as without templates (the same kernels, the same
+// diagnostics).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <sstream>
+#include <vector>
+
+#include "driver/Pipeline.h"
+#include "kernel/Kernel.h"
+
+namespace qdot {
+namespace {
+
+struct Compiled {
+  driver::Compilation c;
+  bool ok = false;
+  Compiled(const std::string& text, bool loops) {
+    c.options.keepLoops = loops;
+    ok = driver::compileSource(c, "model.qd", text, driver::Stage::Kernel);
+  }
+  const kernel::KernelModule& kernels() const { return *c.kernels; }
+  std::string diagnostics() const {
+    std::ostringstream os;
+    c.diags.render(os, c.sources);
+    return os.str();
+  }
+};
+
+size_t loopCount(const kernel::Program& p) {
+  size_t n = 0;
+  for (const auto& i : p.code) n += i.op == kernel::Op::LoopBegin;
+  return n;
+}
+
+// Per row of the scalar DAE, the unknown whose derivative it defines (`der(x) = …`): the row of a
+// templated ODE (row j defines der of unknown j).
+std::vector<size_t> rowOfUnknown(const dae::Dae& scalar) {
+  std::vector<size_t> row;
+  for (const auto& e : scalar.equations) {
+    size_t j = 0;
+    while (j < scalar.variables.size() && scalar.variables[j].yp != e.lhs) ++j;
+    EXPECT_LT(j, scalar.variables.size()) << "a row that defines no derivative";
+    row.push_back(j);
+  }
+  return row;
+}
+
+// (row, column) → entry of a CSC pattern, rows mapped by `row`.
+std::map<std::pair<size_t, size_t>, size_t> entries(const ModelDescription& d, const std::vector<size_t>& row) {
+  std::map<std::pair<size_t, size_t>, size_t> at;
+  for (size_t col = 0; col + 1 < d.jacobianColumnStarts.size(); ++col)
+    for (auto k = static_cast<size_t>(d.jacobianColumnStarts[col]); k < static_cast<size_t>(d.jacobianColumnStarts[col + 1]); ++k)
+      at[{row.empty() ? d.jacobianRowIndices[k] : row[d.jacobianRowIndices[k]], col}] = k;
+  return at;
+}
+
+// The model compiled with and without templates: the templated one is a templated ODE with
+// `blocks` template blocks, and both give the same residual and Jacobian (rows matched by the
+// derivative they define) at a few random states. Returns the residual's loops.
+size_t expectSameKernels(const std::string& text, size_t blocks) {
+  Compiled scalar(text, false), looped(text, true);
+  EXPECT_TRUE(scalar.ok && looped.ok) << scalar.diagnostics() << looped.diagnostics();
+  if (!scalar.ok || !looped.ok) return 0;
+  EXPECT_FALSE(scalar.c.dae->templated());
+  EXPECT_EQ(looped.c.dae->templateBlocks.size(), blocks);
+  const kernel::KernelModule &a = scalar.kernels(), &b = looped.kernels();
+  EXPECT_EQ(a.description.variableNames, b.description.variableNames);
+  EXPECT_EQ(a.description.fixed, b.description.fixed);
+  std::vector<size_t> row = rowOfUnknown(*scalar.c.dae);
+  auto ja = entries(a.description, row), jb = entries(b.description, {});
+  EXPECT_EQ(ja.size(), jb.size());
+  size_t n = a.variableCount(), nnz = a.description.jacobianRowIndices.size();
+  std::vector<double> p(a.description.parameterNames.size()), given(p.size(), 0.0);
+  std::vector<uint8_t> overridden(p.size(), 0);
+  ModelCall call{.given = given.data(), .overridden = overridden.data()};
+  kernel::interpret(a.program(ModelProgram::Parameters), call, p);
+  for (int trial = 0; trial < 3; ++trial) {
+    std::vector<double> y(n), yp(n);
+    for (size_t j = 0; j < n; ++j) {
+      y[j] = 0.1 * std::sin(1.3 * j + trial);
+      yp[j] = 0.2 * std::cos(0.7 * j + 2 * trial);
+    }
+    ModelCall in{.t = 0.3, .cj = 17.0 + trial, .y = y.data(), .yp = yp.data(), .p = p.data()};
+    std::vector<double> fa(n), fb(n), va(nnz), vb(nnz);
+    kernel::interpret(a.program(ModelProgram::Residual), in, fa);
+    kernel::interpret(b.program(ModelProgram::Residual), in, fb);
+    kernel::interpret(a.program(ModelProgram::Jacobian), in, va);
+    kernel::interpret(b.program(ModelProgram::Jacobian), in, vb);
+    for (size_t i = 0; i < n; ++i) EXPECT_NEAR(fb[row[i]], fa[i], 1e-13 * (1 + std::abs(fa[i]))) << "F[" << i << "]";
+    for (const auto& [at, k] : ja) {
+      auto other = jb.find(at);
+      if (other == jb.end()) {
+        ADD_FAILURE() << "no looped entry at (" << at.first << ", " << at.second << ")";
+        continue;
+      }
+      EXPECT_NEAR(vb[other->second], va[k], 1e-13 * (1 + std::abs(va[k]))) << "J(" << at.first << ", " << at.second << ")";
+    }
+  }
+  EXPECT_EQ(loopCount(a.program(ModelProgram::Residual)), 0u);
+  return loopCount(b.program(ModelProgram::Residual));
+}
+
+constexpr const char* kRod = R"(model Rod
+  parameter Integer n = 9;
+  parameter Real a = 1.7;
+  Real T[n](start = {sin(3.14159265358979*i/(n + 1)) for i in 1:n});
+equation
+  der(T[1]) = a*(T[2] - 2*T[1]);
+  for i in 2:n-1 loop
+    der(T[i]) = a*(T[i+1] - 2*T[i] + T[i-1]);
+  end for;
+  der(T[n]) = a*(T[n-1] - 2*T[n]);
+end Rod;
+)";
+
+TEST(ForEquations, RodIsOneLoopWithTheScalarResidualAndJacobian) {
+  EXPECT_EQ(expectSameKernels(kRod, 1), 1u);
+  // Rows in the order of the unknowns is the order the rod is written in: the same pattern.
+  Compiled scalar(kRod, false), looped(kRod, true);
+  EXPECT_EQ(scalar.kernels().description.jacobianRowIndices, looped.kernels().description.jacobianRowIndices);
+  const dae::TemplateBlock& block = looped.c.dae->templateBlocks[0];
+  EXPECT_EQ(block.firstRow, 0);
+  EXPECT_EQ(block.region, (flat::Box{{2, 8}}));
+}
+
+// A plate: the interior is one 2-D template (written with two iterators, or as nested loops), its
+// edges are loops with a constant subscript (not of the template form: scalar rows).
+std::string plate(const std::string& interior) {
+  return R"(model Plate
+  parameter Integer n = 6, m = 5;
+  parameter Real a = 0.8, b = 0.3;
+  Real T[n, m](start = {{sin(i)*cos(j) for j in 1:m} for i in 1:n});
+equation
+)" + interior + R"(
+  for j in 1:m loop
+    der(T[1, j]) = -b*T[1, j];
+    der(T[n, j]) = -b*T[n, j] + sin(time);
+  end for;
+  for i in 2:n-1 loop
+    der(T[i, 1]) = -b*T[i, 1]^3;
+    der(T[i, m]) = -b*T[i, m];
+  end for;
+end Plate;
+)";
+}
+
+TEST(ForEquations, PlateInteriorIsOneLoopWithTheScalarResidualAndJacobian) {
+  EXPECT_EQ(expectSameKernels(plate(R"(  for i in 2:n-1, j in 2:m-1 loop
+    der(T[i, j]) = a*(T[i+1, j] + T[i-1, j] + T[i, j+1] + T[i, j-1] - 4*T[i, j]) - b*T[i, j]^2;
+  end for;)"), 1), 1u);
+}
+
+TEST(ForEquations, NestedLoopsAreOneTemplate) {
+  EXPECT_EQ(expectSameKernels(plate(R"(  for i in 2:n-1 loop
+    for j in 2:m-1 loop
+      der(T[i, j]) = a*(T[i+1, j] + T[i-1, j] + T[i, j+1] + T[i, j-1] - 4*T[i, j]) - b*T[i, j]^2;
+    end for;
+  end for;)"), 1), 1u);
+}
+
+// Two arrays, one loop with two equations (their scalar rows interleave; the templates' rows go by
+// unknown), reading each other's elements.
+TEST(ForEquations, WaveAsTwoArraysGivesTheScalarResidualAndJacobian) {
+  EXPECT_EQ(expectSameKernels(R"(model Wave
+  parameter Integer n = 8;
+  parameter Real c2 = 4, d = 0.05;
+  Real u[n](start = {sin(3.14159265358979*i/(n + 1)) for i in 1:n}), v[n];
+equation
+  der(u[1]) = v[1];
+  der(v[1]) = c2*(u[2] - 2*u[1]) - d*v[1];
+  for i in 2:n-1 loop
+    der(u[i]) = v[i];
+    der(v[i]) = c2*(u[i+1] - 2*u[i] + u[i-1]) - d*v[i];
+  end for;
+  der(u[n]) = v[n];
+  der(v[n]) = c2*(u[n-1] - 2*u[n]) - d*v[n] + cos(2*time);
+end Wave;
+)", 2), 2u);
+}
+
+// Compiled with templates allowed, the model is compiled exactly as without: same kernels, no loop.
+void expectScalarFallback(const std::string& text) {
+  Compiled scalar(text, false), looped(text, true);
+  ASSERT_TRUE(scalar.ok && looped.ok) << scalar.diagnostics() << looped.diagnostics();
+  EXPECT_FALSE(looped.c.dae->templated());
+  std::ostringstream a, b;
+  kernel::printKernels(a, scalar.kernels());
+  kernel::printKernels(b, looped.kernels());
+  EXPECT_EQ(a.str(), b.str());
+  EXPECT_EQ(loopCount(looped.kernels().program(ModelProgram::Residual)), 0u);
+}
+
+TEST(ForEquations, AnAlgebraicUnknownKeepsTheModelScalar) {
+  expectScalarFallback(R"(model Algebraic
+  parameter Integer n = 7;
+  Real x[n](start = {0.1*i for i in 1:n}), q[n];
+equation
+  for i in 1:n loop
+    der(x[i]) = -q[i];
+  end for;
+  for i in 1:n loop
+    q[i] = x[i]^3 + 0.5*x[i];
+  end for;
+end Algebraic;
+)");
+}
+
+TEST(ForEquations, ANonAffineSubscriptKeepsTheLoopScalar) {
+  expectScalarFallback(R"(model Reversed
+  parameter Integer n = 7;
+  Real x[n](start = {0.1*i for i in 1:n});
+equation
+  for i in 1:n loop
+    der(x[i]) = -x[n + 1 - i] + 0.1*x[i];
+  end for;
+end Reversed;
+)");
+}
+
+TEST(ForEquations, AnUnknownWithoutEquationKeepsTheModelScalar) {
+  expectScalarFallback(R"(model Partial
+  parameter Integer n = 5;
+  Real x[n](start = {0.1*i for i in 1:n}), w;
+equation
+  for i in 1:n loop
+    der(x[i]) = -x[i] + w;
+  end for;
+  w = sin(time);
+end Partial;
+)");
+}
+
+// An error inside a loop that could have been a template is reported as without templates.
+TEST(ForEquations, ErrorsAreThoseOfTheScalarLowering) {
+  const char* text = R"(model Bad
+  parameter Integer n = 5;
+  Real x[n];
+equation
+  for i in 1:n loop
+    der(x[i]) = -x[i+1];
+  end for;
+end Bad;
+)";
+  Compiled scalar(text, false), looped(text, true);
+  EXPECT_FALSE(scalar.ok);
+  EXPECT_FALSE(looped.ok);
+  EXPECT_FALSE(scalar.diagnostics().empty());
+  EXPECT_EQ(scalar.diagnostics(), looped.diagnostics());
+}
+
+// At a size where one equation per element would show, flattening keeps one template.
+TEST(ForEquations, ALargeRodIsOneTemplate) {
+  std::string text = kRod;
+  text.replace(text.find("n = 9"), 5, "n = 50000");
+  Compiled looped(text, true);
+  ASSERT_TRUE(looped.ok) << looped.diagnostics();
+  ASSERT_EQ(looped.c.dae->templateBlocks.size(), 1u);
+  EXPECT_EQ(looped.c.dae->templateBlocks[0].region, (flat::Box{{2, 49999}}));
+  EXPECT_EQ(looped.kernels().variableCount(), 50000u);
+  EXPECT_LT(looped.kernels().program(ModelProgram::Residual).code.size(), 100u);
+}
+
+}  // namespace
+}  // namespace qdot
