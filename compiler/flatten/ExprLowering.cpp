@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include "flatten/Flattener.h"
 #include "support/Assert.h"
@@ -335,15 +336,49 @@ Value Flattener::lowerArray(const ArrayExpr& e) {
   return stack(std::move(parts), e.range);
 }
 
-// {body for i in r1, j in r2}: the first iterator is the first dimension.
+// {body for i in r1, j in r2}: the first iterator is the first dimension. Each range is lowered
+// once and the elements go straight into one list: a comprehension over a large array (the start
+// values of x[n]) makes no Value per element. Checked as stack() checks array literals.
 Value Flattener::lowerComprehension(const ComprehensionExpr& e) {
-  std::vector<Value> parts;
-  std::vector<int> dims;
-  for (const auto& it : e.iterators) dims.push_back(static_cast<int>(iterationValues(*it.range).size()));
-  forEachIteration(e.iterators, 0, [&] { parts.push_back(lower(*e.body)); });
-  Value v = stack(std::move(parts), e.range);
-  v.shape.erase(v.shape.begin());
-  v.shape.insert(v.shape.begin(), dims.begin(), dims.end());
+  std::vector<std::vector<Expr>> ranges;
+  Value v;
+  size_t count = 1;
+  for (const auto& it : e.iterators) {
+    ranges.push_back(iterationValues(*it.range));
+    v.shape.push_back(static_cast<int>(ranges.back().size()));
+    count *= ranges.back().size();
+  }
+  std::optional<std::vector<int>> elementShape, otherShape;
+  auto element = [&] {
+    Value part = lower(*e.body);
+    if (!elementShape) {
+      elementShape = part.shape;
+      v.elems.reserve(count * part.size());
+    } else if (!otherShape && part.shape != *elementShape) {
+      otherShape = part.shape;
+    }
+    v.elems.append(part.elems);
+  };
+  auto walk = [&](auto& self, size_t k) -> void {
+    if (k == ranges.size()) return element();
+    const Iterator& it = e.iterators[k];
+    if (dyn_cast<RangeExpr>(it.range.get())) countScalars(ranges[k].size(), it.range->range);  // as for a loop
+    for (Expr value : ranges[k]) {
+      iterators_.emplace_back(it.name, value);
+      try {
+        self(self, k + 1);
+      } catch (...) {
+        iterators_.pop_back();
+        throw;
+      }
+      iterators_.pop_back();
+    }
+  };
+  walk(walk, 0);
+  if (otherShape)
+    fail(e.range, DiagCode::E0307, "array elements have different shapes: " + shapeText(*elementShape) + " and " +
+                                  shapeText(*otherShape));
+  if (elementShape) v.shape.insert(v.shape.end(), elementShape->begin(), elementShape->end());
   return v;
 }
 

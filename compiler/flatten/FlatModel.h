@@ -32,26 +32,29 @@ enum class VarRole : uint8_t {
 };
 const char* roleName(VarRole r);
 
+// A large model has three of these per array element (and the DAE keeps a copy per unknown), so
+// the two indices sit in what would be padding after the flags and after declRange: 128 bytes, not 136.
 struct Variable {
   std::string_view name;  ///< user-facing scalar name: `th[1]`, `der(th[1])` (the symbol's name)
   VarRole role = VarRole::Unknown;
   bool fixed = false;
   bool fixedGiven = false;  ///< `fixed` written by the user (else a default: a coordinate's start is fixed)
   bool input = false;  ///< Parameter: an `input` of the model (value 0 unless set; B of `qdot linearize`)
+  int derivative = -1;  ///< index of the variable that is der(this), -1 if none
   sym::Expr symbol = nullptr;
   SourceRange declRange;  ///< the declaration's name (or the der() that created it)
+  int derivativeOf = -1;  ///< this is der(variables[derivativeOf])
   std::string_view description;
   std::string_view unit;
   sym::Expr start = nullptr;  ///< start attribute (over parameters); null if none
   sym::Expr nominal = nullptr, min = nullptr, max = nullptr;
   sym::Expr value = nullptr;  ///< Parameter: default value (over other parameters)
-  int derivative = -1;        ///< index of the variable that is der(this), -1 if none
-  int derivativeOf = -1;      ///< this is der(variables[derivativeOf])
   /// Not an unknown: equal to this expression (another variable, or one of parameters and time)
   /// through connections and alias equations (`a.s = s`, `a.s = s0`). The Euler–Lagrange rows are
   /// derived with the variable itself; the DAE substitutes the alias everywhere.
   sym::Expr alias = nullptr;
 };
+static_assert(sizeof(Variable) <= 128, "flat::Variable: keep the indices in the padding (see above)");
 
 enum class OriginKind {
   Equation,         ///< a line of the equation section

@@ -3,6 +3,7 @@
 #include "flatten/Flatten.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 
 #include "flatten/Flattener.h"
@@ -14,25 +15,55 @@ using namespace qdot::ast;
 using sema::SymbolKind;
 using sym::Expr;
 
-// Scalar names in row-major order: x, x[1], M[1,2].
-static std::vector<std::string> scalarNames(const std::string& base, const std::vector<int>& shape) {
+// f(name) for each scalar name in row-major order: x, x[1], M[1,2]. One buffer is rewritten in
+// place, so a large array's names cost no allocation each.
+template <class F>
+static void forEachScalarName(const std::string& base, const std::vector<int>& shape, F&& f) {
   size_t n = 1;
   for (int s : shape) n *= static_cast<size_t>(s);
-  std::vector<std::string> names;
-  names.reserve(n);
   std::vector<int> idx(shape.size(), 1);
+  std::string name;
+  char digits[16];
   for (size_t k = 0; k < n; ++k) {
-    std::string name = base;
-    for (size_t i = 0; i < idx.size(); ++i) name += (i ? "," : "[") + std::to_string(idx[i]);
-    names.push_back(idx.empty() ? name : name + "]");
+    name.assign(base);
+    for (size_t i = 0; i < idx.size(); ++i) {
+      name += i ? ',' : '[';
+      name.append(digits, std::to_chars(digits, digits + sizeof digits, idx[i]).ptr);
+    }
+    if (!idx.empty()) name += ']';
+    f(std::string_view(name));
     for (size_t i = idx.size(); i-- > 0;) {
       if (++idx[i] <= shape[i]) break;
       idx[i] = 1;
     }
   }
-  return names;
 }
 
+namespace {
+
+// Many names in one buffer instead of a string each; viewed once all are written (the buffer moves
+// while it grows).
+struct NameBuffer {
+  std::string chars;
+  std::vector<size_t> ends;
+  /// The characters appended since the previous name are a name.
+  void finish() { ends.push_back(chars.size()); }
+  std::vector<std::string_view> views() const {
+    std::vector<std::string_view> out;
+    out.reserve(ends.size());
+    size_t begin = 0;
+    for (size_t end : ends) out.emplace_back(chars.data() + begin, end - begin), begin = end;
+    return out;
+  }
+};
+
+}  // namespace
+
+static std::vector<std::string> scalarNames(const std::string& base, const std::vector<int>& shape) {
+  std::vector<std::string> names;
+  forEachScalarName(base, shape, [&](std::string_view name) { names.emplace_back(name); });
+  return names;
+}
 
 const char* roleName(VarRole r) {
   switch (r) {
@@ -149,12 +180,36 @@ int Flattener::derivativeVariable(int var, SourceRange where) {
     fail(where, DiagCode::E0311,
          "cannot take the derivative of '" + std::string(out_.variables[var].name) + "' (a " + roleName(role) + ")",
          "higher derivatives are only available for coordinates: declare the variable as 'coordinate Real'");
-  Expr symbol = ctx_.symbol("der(" + std::string(out_.variables[var].name) + ")");
-  Variable d{.role = derRole, .symbol = symbol, .declRange = out_.variables[var].declRange};
+  derivativeName_.assign("der(").append(out_.variables[var].name) += ')';
+  return addDerivative(var, derRole, ctx_.symbol(derivativeName_));
+}
+
+int Flattener::addDerivative(int var, VarRole role, Expr symbol) {
+  Variable d{.role = role, .symbol = symbol, .declRange = out_.variables[var].declRange};
   d.derivativeOf = var;
   int index = addVariable(std::move(d));
   out_.variables[var].derivative = index;
   return index;
+}
+
+// Every coordinate has a velocity and an acceleration, used or not: der(x[1]), der(der(x[1])),
+// der(x[2]), … in the order derivativeVariable would make them, with their symbols made at once
+// (Context::symbols). A declaration lowered again after a dependency already has them.
+void Flattener::addCoordinateDerivatives(const Value& coordinates) {
+  std::vector<int> vars;
+  NameBuffer names;
+  for (Expr x : coordinates.elems) {
+    int var = out_.variableOf(x);
+    if (out_.variables[var].derivative >= 0) continue;
+    vars.push_back(var);
+    names.chars.append("der(").append(out_.variables[var].name) += ')';
+    names.finish();
+    names.chars.append("der(der(").append(out_.variables[var].name) += "))";
+    names.finish();
+  }
+  std::vector<Expr> symbols = ctx_.symbols(names.views());
+  for (size_t k = 0; k < vars.size(); ++k)
+    addDerivative(addDerivative(vars[k], VarRole::Velocity, symbols[2 * k]), VarRole::Acceleration, symbols[2 * k + 1]);
 }
 
 // A declaration's value, created on first use. Declarations may use each other in any order, and a
@@ -311,8 +366,7 @@ Value Flattener::createDeclaration(const Declaration& d, const sema::ModelSymbol
         out_.variables[var].fixed = coord && !promoted;
         connectorPotential_[var] = cur_->cls->isConnector() && !d.isFlow;
       }
-      if (coord)  // every coordinate has a velocity and an acceleration, used or not
-        for (Expr x : vars.elems) derivativeVariable(derivativeVariable(out_.variableOf(x), d.nameRange), d.nameRange);
+      if (coord) addCoordinateDerivatives(vars);
       applyAttributes(d, vars);
       return vars;
     }
@@ -333,17 +387,24 @@ Value Flattener::variablesFor(const Declaration& d, const std::vector<int>& shap
   Instance::Slot& slot = cur_->slots[creating_->index];
   if (slot.hasVariables) return slot.variables;
   Value v{shape, {}};
-  std::vector<std::string> names = scalarNames(cur_->prefix() + d.name, shape);
+  size_t count = 1;
+  for (int n : shape) count *= static_cast<size_t>(n);
   // a coordinate brings its velocity and acceleration
-  reserveVariables(role == VarRole::Coordinate ? 3 * names.size() : names.size());
-  v.elems.reserve(names.size());
+  size_t withDerivatives = role == VarRole::Coordinate ? 3 * count : count;
+  reserveVariables(withDerivatives);
+  ctx_.reserve(withDerivatives, 0);
+  v.elems.reserve(count);
   // A component's variable is located where the model compiled declares the component (`Spring
   // k1;`): what the user can change, rather than a line of the library.
   const Instance* top = cur_;
   while (top->parent && top->parent->parent) top = top->parent;
   SourceRange where = top->decl ? top->decl->nameRange : d.nameRange;
-  for (const std::string& name : names) {
-    Expr symbol = ctx_.symbol(name);
+  NameBuffer names;
+  forEachScalarName(cur_->prefix() + d.name, shape, [&](std::string_view name) {
+    names.chars += name;
+    names.finish();
+  });
+  for (Expr symbol : ctx_.symbols(names.views())) {
     addVariable({.role = role, .symbol = symbol, .declRange = where, .description = d.description});
     v.elems.push_back(symbol);
   }

@@ -204,6 +204,7 @@ class Flattener {
   size_t scalars_ = 0;
   sym::DirectionalDerivative timeDerivative_{ctx_};  ///< der(): memo shared by all calls
   SourceRange derivativeSite_;                       ///< the der() being expanded (for E0311)
+  std::string derivativeName_;                       ///< derivativeVariable's buffer for "der(x[1])"
 
   std::deque<Instance> instances_;  ///< [0] is the model; then components in creation order
   Instance* cur_ = nullptr;         ///< whose names the expressions being lowered use
@@ -271,6 +272,8 @@ class Flattener {
   int addVariable(Variable v);
   void reserveVariables(size_t count);
   int derivativeVariable(int var, SourceRange where);
+  int addDerivative(int var, VarRole role, sym::Expr symbol);
+  void addCoordinateDerivatives(const Value& coordinates);
   void checkShape(const Value& v, const std::vector<int>& shape, SourceRange r, const std::string& what);
   void countScalars(size_t n, SourceRange r);
   void lowerEquation(const ast::Equation& eq, std::vector<Equation>& into, OriginKind kind);

@@ -256,6 +256,7 @@ Expr Context::scale(double c, Expr a) {
 Expr Context::mul(Expr a, Expr b) {
   if (a->isOne()) return b;
   if (b->isOne()) return a;
+  if (a->isConstant() && b->isConstant()) return constant(a->value * b->value);  // what the builder gives
   MulBuilder m(*this);
   m.factor(a);
   m.factor(b);

@@ -2,7 +2,10 @@
 // Every node is created through Impl::intern, which computes the structural hash, the symbol mask
 // and the depth from the (already built) children and returns the existing node when one is equal;
 // only a new node is copied into the arena (node and operands), so a lookup that hits allocates nothing.
+// Symbols are the exception: unique by name, they are found through the name table and never enter
+// the intern table (a large model has millions; the table would only grow and rehash for them).
 #include <algorithm>
+#include <bit>
 #include <cstddef>
 #include <functional>
 #include <new>
@@ -80,12 +83,13 @@ bool shallowEqual(const Node& a, const Node& b) {
 Expr Context::Impl::intern(Node& key) {
   key.value = normalizeNumber(key.value);
   computeDerived(key);
-  if ((nodeCount + 1) * 2 > tableSize) growTable();
+  if ((tableCount + 1) * 2 > tableSize) resizeTable(tableSize ? 2 * tableSize : 1024);
   size_t mask = tableSize - 1;
   size_t i = key.hash & mask;
   for (; table[i].node; i = (i + 1) & mask)  // the stored hash spares loading non-matching nodes
     if (table[i].hash == key.hash && shallowEqual(*table[i].node, key)) return table[i].node;
   table[i] = {key.hash, store(key)};
+  ++tableCount;
   return table[i].node;
 }
 
@@ -109,9 +113,8 @@ Expr Context::Impl::store(const Node& key) {
   return n;
 }
 
-void Context::Impl::growTable() {
-  size_t oldSize = tableSize;
-  tableSize = tableSize ? 2 * tableSize : 1024;
+void Context::Impl::resizeTable(size_t size) {
+  size_t oldSize = std::exchange(tableSize, size);
   auto old = std::exchange(table, allocateLarge<TableSlot>(tableSize));
   std::fill_n(table.get(), tableSize, TableSlot{});
   size_t mask = tableSize - 1;
@@ -121,6 +124,16 @@ void Context::Impl::growTable() {
     while (table[i].node) i = (i + 1) & mask;
     table[i] = old[k];
   }
+}
+
+// Each table stays at most half full; the vector of symbols grows geometrically even when callers
+// reserve a little at a time.
+void Context::Impl::reserve(size_t moreSymbols, size_t moreNodes) {
+  size_t nodes = tableCount + moreNodes;
+  if (nodes * 2 > tableSize) resizeTable(std::bit_ceil(std::max<size_t>(nodes * 2, 1024)));
+  size_t names = symbols.size() + moreSymbols;
+  if (names * 2 > nameTableSize) resizeSymbolsByName(std::bit_ceil(std::max<size_t>(names * 2, 64)));
+  if (names > symbols.capacity()) symbols.reserve(std::max(names, 2 * symbols.capacity()));
 }
 
 Expr Context::Impl::makeMul(double coef, std::span<const Expr> bases, std::span<const Expr> exps) {
@@ -162,49 +175,76 @@ Expr Context::constant(double v) {
   return slot.node;
 }
 
+void Context::reserve(size_t symbols, size_t nodes) { impl_->reserve(symbols, nodes); }
+
 Expr Context::symbol(std::string_view name) {
-  uint64_t hash = std::hash<std::string_view>{}(name);
-  if (Expr s = impl_->findSymbol(name, hash)) return s;
-  Node n{};
-  n.kind = Kind::Symbol;
-  n.symbolId = static_cast<uint32_t>(impl_->symbols.size());
-  Expr s = impl_->intern(n);
-  impl_->symbols.push_back(s);
-  impl_->symbolNames.emplace_back(name);
-  impl_->addSymbolName(hash, s->symbolId);
+  impl_->reserve(1, 0);
+  return impl_->symbol(name, std::hash<std::string_view>{}(name));
+}
+
+// Hashes every name first; then, while one name is looked up, the slot of a name some places
+// further on is already being loaded (the table is reserved up front, so it does not move).
+std::vector<Expr> Context::symbols(std::span<const std::string_view> names) {
+  constexpr size_t kAhead = 16;
+  impl_->reserve(names.size(), 0);
+  std::vector<uint64_t> hashes(names.size());
+  for (size_t i = 0; i < names.size(); ++i) hashes[i] = std::hash<std::string_view>{}(names[i]);
+  std::vector<Expr> out;
+  out.reserve(names.size());
+  size_t mask = impl_->nameTableSize - 1;
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (i + kAhead < names.size()) __builtin_prefetch(&impl_->symbolsByName[hashes[i + kAhead] & mask]);
+    out.push_back(impl_->symbol(names[i], hashes[i]));
+  }
+  return out;
+}
+
+Expr Context::Impl::symbol(std::string_view name, uint64_t hash) {
+  NameSlot& slot = nameSlot(name, hash);
+  if (slot.entry) return symbols[slot.entry - 1];
+  Expr s = newSymbol(name);
+  slot = {static_cast<uint32_t>(hash), s->symbolId + 1};
   return s;
 }
 
 Expr Context::findSymbol(std::string_view name) const {
-  return impl_->findSymbol(name, std::hash<std::string_view>{}(name));
+  if (impl_->nameTableSize == 0) return nullptr;
+  const Impl::NameSlot& slot = impl_->nameSlot(name, std::hash<std::string_view>{}(name));
+  return slot.entry ? impl_->symbols[slot.entry - 1] : nullptr;
 }
 
-Expr Context::Impl::findSymbol(std::string_view name, uint64_t hash) const {
-  if (symbolsByName.empty()) return nullptr;
-  size_t mask = symbolsByName.size() - 1;
-  for (size_t i = hash & mask; symbolsByName[i].used; i = (i + 1) & mask) {
-    const NameSlot& slot = symbolsByName[i];
-    if (slot.hash == hash && symbolNames[slot.symbolId] == name) return symbols[slot.symbolId];
+// Linear probing; a slot whose tag differs cannot hold the name, so most misses compare no string.
+Context::Impl::NameSlot& Context::Impl::nameSlot(std::string_view name, uint64_t hash) {
+  size_t mask = nameTableSize - 1;
+  auto tag = static_cast<uint32_t>(hash);
+  for (size_t i = hash & mask;; i = (i + 1) & mask) {
+    NameSlot& slot = symbolsByName[i];
+    if (slot.entry == 0 || (slot.tag == tag && symbolNames[slot.entry - 1] == name)) return slot;
   }
-  return nullptr;
 }
 
-void Context::Impl::addSymbolName(uint64_t hash, uint32_t symbolId) {
-  if ((symbols.size() + 1) * 2 > symbolsByName.size()) growSymbolsByName();
-  size_t mask = symbolsByName.size() - 1, i = hash & mask;
-  while (symbolsByName[i].used) i = (i + 1) & mask;
-  symbolsByName[i] = {hash, symbolId, true};
+Expr Context::Impl::newSymbol(std::string_view name) {
+  Node n{};
+  n.kind = Kind::Symbol;
+  n.symbolId = static_cast<uint32_t>(symbols.size());
+  computeDerived(n);
+  Expr s = store(n);
+  symbols.push_back(s);
+  symbolNames.emplace_back(name);
+  return s;
 }
 
-void Context::Impl::growSymbolsByName() {
-  std::vector<NameSlot> old(symbolsByName.empty() ? 64 : symbolsByName.size() * 2);
-  old.swap(symbolsByName);
-  size_t mask = symbolsByName.size() - 1;
-  for (const NameSlot& s : old) {
-    if (!s.used) continue;
-    size_t i = s.hash & mask;
-    while (symbolsByName[i].used) i = (i + 1) & mask;
-    symbolsByName[i] = s;
+// A tag is the low half of the name's hash, so it places its slot in any table of up to 2^32 slots.
+void Context::Impl::resizeSymbolsByName(size_t size) {
+  size_t oldSize = std::exchange(nameTableSize, size);
+  auto old = std::exchange(symbolsByName, allocateLarge<NameSlot>(size));
+  std::fill_n(symbolsByName.get(), size, NameSlot{0, 0});
+  size_t mask = size - 1;
+  for (size_t k = 0; k < oldSize; ++k) {
+    if (!old[k].entry) continue;
+    size_t i = old[k].tag & mask;
+    while (symbolsByName[i].entry) i = (i + 1) & mask;
+    symbolsByName[i] = old[k];
   }
 }
 

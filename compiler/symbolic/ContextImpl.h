@@ -106,7 +106,8 @@ struct Context::Impl {
 
   Context& ctx;
   Arena arena;                      ///< nodes and their operand arrays
-  size_t nodeCount = 0;
+  size_t nodeCount = 0;             ///< every node, symbols included
+  size_t tableCount = 0;            ///< nodes in the intern table (not symbols: see newSymbol)
   struct TableSlot {  // trivial, so a new table is not touched before it is advised
     uint64_t hash;
     Expr node;
@@ -122,12 +123,12 @@ struct Context::Impl {
   std::vector<ConstantSlot> recentConstants = std::vector<ConstantSlot>(size_t{1} << kConstantCacheBits);
   std::deque<std::string> symbolNames;  ///< by symbolId (deque keeps references stable)
   std::vector<Expr> symbols;            ///< by symbolId
-  struct NameSlot {
-    uint64_t hash = 0;
-    uint32_t symbolId = 0;
-    bool used = false;
+  struct NameSlot {  // trivial, like TableSlot: a large table asks for huge pages before it is touched
+    uint32_t tag;    ///< low half of the name's hash (all the table's position needs)
+    uint32_t entry;  ///< symbolId + 1; 0 = empty
   };
-  std::vector<NameSlot> symbolsByName;  ///< open addressing over the name hashes
+  std::unique_ptr<NameSlot[]> symbolsByName;  ///< open addressing over the name hashes
+  size_t nameTableSize = 0;                   ///< a power of two, or 0
   /// By symbolId of the variable differentiated by: node -> derivative. A map, not a vector by id:
   /// a large model differentiates by few of its millions of symbols (and the memo's references
   /// stay valid while a derivative by another symbol is added).
@@ -142,14 +143,20 @@ struct Context::Impl {
   Expr makeMul(double coef, std::span<const Expr> bases, std::span<const Expr> exps);
   /// Rebuilds n with new children (args then exps), re-simplifying. Returns n if unchanged.
   Expr rebuild(Expr n, std::span<const Expr> kids);
-  /// The symbol with this name, or nullptr.
-  Expr findSymbol(std::string_view name, uint64_t hash) const;
-  void addSymbolName(uint64_t hash, uint32_t symbolId);
+  /// The slot of the symbol with this name in symbolsByName, or the empty slot where it belongs.
+  NameSlot& nameSlot(std::string_view name, uint64_t hash);
+  /// The symbol with this name, made if new; the name table must have room for one more.
+  Expr symbol(std::string_view name, uint64_t hash);
+  /// A symbol node with the next symbolId, stored without entering the intern table: a symbol is
+  /// only ever found by name, never by structure, so the table need not hold (or rehash) it.
+  Expr newSymbol(std::string_view name);
+  /// Room for `symbols` more symbols and `nodes` more interned nodes without rehashing.
+  void reserve(size_t symbols, size_t nodes);
 
  private:
   Expr store(const Node& key);
-  void growTable();
-  void growSymbolsByName();
+  void resizeTable(size_t size);
+  void resizeSymbolsByName(size_t size);
 };
 
 /// Accumulates constant + Σ coef·term and builds the canonical Add (flattening nested sums and

@@ -94,8 +94,14 @@ class Context {
   Expr one() const { return one_; }
   /// A new symbol, or the existing one with this name (names are unique per Context).
   Expr symbol(std::string_view name);
+  /// symbol(name) for each name, in order (new symbols get their ids in this order). For many names
+  /// at once, a large array's: the name table is read ahead, so the lookups' cache misses overlap.
+  std::vector<Expr> symbols(std::span<const std::string_view> names);
   /// Lookup without creating; nullptr if none.
   Expr findSymbol(std::string_view name) const;
+  /// Room for `symbols` more symbols and `nodes` more other nodes: a caller about to make many (a
+  /// large array's variables) spares the tables rehashing as they grow. Never changes any result.
+  void reserve(size_t symbols, size_t nodes);
   const std::string& symbolName(Expr s) const;
   size_t symbolCount() const;
 

@@ -97,6 +97,52 @@ TEST(Storage, ManySymbolsWithLongNames) {
   EXPECT_EQ(ctx.findSymbol(""), nullptr);
 }
 
+// Context::reserve resizes the intern and name tables ahead of what is made: every expression and
+// symbol made before is found again (the same node), both after reserving and after the tables
+// later grow past the reservation, and a symbol never becomes a node of the intern table's kind
+// (x*x is x^2, not a second x).
+TEST(Storage, ReserveKeepsInterningAndNames) {
+  Context ctx;
+  auto build = [&](size_t i) {
+    Expr x = ctx.symbol(numbered("x", i));
+    return ctx.add(ctx.mul(ctx.constant(0.5 + double(i)), ctx.pow(x, ctx.constant(2))), ctx.unary(Kind::Sin, x));
+  };
+  std::vector<Expr> before;
+  for (size_t i = 0; i < 300; ++i) before.push_back(build(i));
+  size_t symbols = ctx.symbolCount(), nodes = ctx.nodeCount();
+  ctx.reserve(100000, 100000);
+  EXPECT_EQ(ctx.symbolCount(), symbols);
+  EXPECT_EQ(ctx.nodeCount(), nodes);
+  for (size_t i = 0; i < before.size(); ++i) EXPECT_EQ(build(i), before[i]) << i;
+  EXPECT_EQ(ctx.nodeCount(), nodes);  // nothing new: every node was found
+  std::vector<Expr> after;
+  for (size_t i = 300; i < 60000; ++i) after.push_back(build(i));  // past the reservation: the tables grow
+  for (size_t i = 0; i < before.size(); ++i) EXPECT_EQ(build(i), before[i]) << i;
+  for (size_t i = 300; i < 60000; i += 599) EXPECT_EQ(build(i), after[i - 300]) << i;
+  EXPECT_EQ(ctx.symbolCount(), 60000u);
+  for (size_t i = 0; i < 60000; i += 1009) {
+    Expr x = ctx.findSymbol(numbered("x", i));
+    ASSERT_NE(x, nullptr);
+    EXPECT_EQ(x->symbolId, i);
+    EXPECT_EQ(ctx.symbolName(x), numbered("x", i));
+    EXPECT_EQ(ctx.mul(x, x), ctx.pow(x, ctx.constant(2)));
+    EXPECT_EQ(ctx.sub(ctx.add(x, ctx.one()), x), ctx.one());
+  }
+  EXPECT_EQ(ctx.findSymbol("x60000"), nullptr);
+}
+
+// A product of two numbers is the constant of their product, whichever path builds it.
+TEST(Storage, ProductOfNumbersIsAConstant) {
+  Context ctx;
+  for (double a : {0.01, -3.0, 0.0, 1e300, 7.5})
+    for (double b : {3.0, -0.0, 1e10, std::numeric_limits<double>::infinity()}) {
+      Expr expected = ctx.constant(a * b);
+      EXPECT_EQ(ctx.mul(ctx.constant(a), ctx.constant(b)), expected) << a << " * " << b;
+      Expr both[] = {ctx.constant(a), ctx.constant(b)};
+      EXPECT_EQ(ctx.mul(both), expected) << a << " * " << b;
+    }
+}
+
 // S·cos(S) with S = Σ sin(s_i), so S is reached twice: 2n + 4 nodes, small (inline visited set,
 // up to 32 nodes) and large (hash set) cases.
 TEST(Storage, TraversalsAgreeOnSmallAndLargeExpressions) {
