@@ -44,7 +44,7 @@ class Builder {
       dae_.invariants.push_back({fi.name, fi.kind == mech::FirstIntegral::Kind::Jacobi ? "Jacobi integral" : "cyclic momentum",
                                  substituted(fi.value)});
     if (!aliases_.empty()) substituteRest();
-    if (!eom_.templateRows.empty()) addTemplateBlocks();
+    if (!eom_.templateRows.empty()) addTemplateBlocks(), addScalarKinematicResiduals();
     // Template rows are one Euler–Lagrange row per coordinate and its kinematic row by construction.
     if (diags_.errorCount() == errorsBefore && !dae_.templated()) checkBalance(dae_, ctx_, diags_);
     if (diags_.errorCount() > errorsBefore) return std::nullopt;
@@ -58,6 +58,8 @@ class Builder {
   DiagnosticEngine& diags_;
   Dae dae_;
   std::vector<Equation> kinematic_;
+  enum RowKind : char { Skip, Algebraic, NotInertial, Inertial };  ///< of a coordinate's row, in addMechanics
+  std::vector<char> kinematicTaken_;  ///< per kinematic row (templated models): a template's
   std::vector<std::pair<int, int>> kinematicPairs_;  ///< per kinematic row: coordinate, velocity (index among velocities)
   std::unordered_map<Expr, Expr> aliases_;  ///< symbol of a variable that is not an unknown → its value
   uint64_t aliasMask_ = 0;
@@ -120,7 +122,6 @@ class Builder {
   // model's unknowns and kinematic rows are not built in temporaries and then moved.
   void addMechanics() {
     markAppearances();
-    enum : char { Skip, Algebraic, NotInertial, Inertial };
     std::vector<char> kindOf(eom_.rows.size(), Skip);
     for (size_t r = 0; r < eom_.rows.size(); ++r) {
       const auto& row = eom_.rows[r];
@@ -134,6 +135,8 @@ class Builder {
     size_t states = std::count_if(kindOf.begin(), kindOf.end(), [](char k) { return k == Inertial || k == NotInertial; });
     kinematic_.reserve(states);
     kinematicPairs_.reserve(states);
+    std::vector<Expr> rates = rateSymbols(kindOf);
+    size_t state = 0;
     for (size_t r = 0; r < eom_.rows.size(); ++r) {
       if (kindOf[r] == Skip) continue;
       const flat::Variable& q = m_.variables[eom_.rows[r].coordinate];
@@ -143,9 +146,10 @@ class Builder {
         continue;
       }
       Variable qv = fromFlat(eom_.rows[r].coordinate, VarKind::State, UnknownRole::Coordinate);
-      qv.yp = ctx_.symbol("$der(" + std::string(q.name) + ")");
-      kinematic_.push_back({ctx_.sub(qv.yp, m_.variables[q.derivative].symbol),
-                            {flat::OriginKind::Kinematic, q.declRange, eom_.rows[r].coordinate, ""}});
+      qv.yp = rates[state++];
+      // A templated model's kinematic rows are made when addTemplateBlocks has taken its arrays'.
+      Expr residual = eom_.templateRows.empty() ? ctx_.sub(qv.yp, m_.variables[q.derivative].symbol) : nullptr;
+      kinematic_.push_back({residual, {flat::OriginKind::Kinematic, q.declRange, eom_.rows[r].coordinate, ""}});
       kinematicPairs_.push_back({static_cast<int>(dae_.variables.size()), static_cast<int>(kinematicPairs_.size())});
       dae_.variables.push_back(std::move(qv));
     }
@@ -161,6 +165,31 @@ class Builder {
     }
     int row = static_cast<int>(eom_.rows.size());  // the kinematic rows follow the Euler–Lagrange rows
     for (auto [coordinate, velocity] : kinematicPairs_) dae_.links.push_back({row++, coordinate, firstVelocity + velocity});
+  }
+
+  // The symbols of the coordinates' rates `$der(q)`, of the states among them in row order: made
+  // in one batch (a large array's), with the ids one by one would give.
+  std::vector<Expr> rateSymbols(const std::vector<char>& kindOf) {
+    std::string buffer;
+    std::vector<size_t> ends;
+    for (size_t r = 0; r < eom_.rows.size(); ++r) {
+      if (kindOf[r] != Inertial && kindOf[r] != NotInertial) continue;  // not a state
+      buffer.append("$der(").append(m_.variables[eom_.rows[r].coordinate].name).append(")");
+      ends.push_back(buffer.size());
+    }
+    std::vector<std::string_view> names;
+    names.reserve(ends.size());
+    for (size_t k = 0, begin = 0; k < ends.size(); begin = ends[k++]) names.emplace_back(buffer.data() + begin, ends[k] - begin);
+    return ctx_.symbols(names);
+  }
+
+  // The kinematic rows q' - der(q) that no template took (templated models only).
+  void addScalarKinematicResiduals() {
+    for (size_t k = 0; k < dae_.links.size(); ++k) {
+      const DerivativeLink& link = dae_.links[k];
+      if (k < kinematicTaken_.size() && kinematicTaken_[k]) continue;
+      dae_.equations[link.row].residual = ctx_.sub(dae_.variables[link.variable].yp, dae_.variables[link.derivative].y);
+    }
   }
 
   void addUnknowns() {
@@ -213,6 +242,7 @@ class Builder {
   // $der(x)[%…] − der(x)[%…] (rows of the same order as its elements').
   void addTemplateBlocks() {
     dae_.patterns = m_.patterns;
+    kinematicTaken_.assign(dae_.links.size(), 0);
     flat::ElementPatterns& patterns = *m_.patterns;
     std::unordered_map<int, int> rowOfFlat, kinematicRowOfFlat;
     for (int r = 0; r < static_cast<int>(eom_.rows.size()); ++r) rowOfFlat.emplace(eom_.rows[r].coordinate, r);
@@ -247,6 +277,7 @@ class Builder {
         int row = kinematicRowOfFlat.at(m_.variableOf(e));
         rates.elements.push_back(dae_.variables[dae_.links[row - eom_.rows.size()].variable].yp);
         dae_.equations[row].residual = nullptr;
+        kinematicTaken_[row - eom_.rows.size()] = 1;
       }
       patterns.arrays.push_back(std::move(rates));
       flat::RelativeElement own{static_cast<int>(patterns.arrays.size()) - 1, {}};
