@@ -244,26 +244,32 @@ class Builder {
     dae_.patterns = m_.patterns;
     kinematicTaken_.assign(dae_.links.size(), 0);
     flat::ElementPatterns& patterns = *m_.patterns;
-    std::unordered_map<int, int> rowOfFlat, kinematicRowOfFlat;
-    for (int r = 0; r < static_cast<int>(eom_.rows.size()); ++r) rowOfFlat.emplace(eom_.rows[r].coordinate, r);
-    for (const auto& link : dae_.links) kinematicRowOfFlat.emplace(dae_.variables[link.variable].flatVar, link.row);
+    // By flat variable: the row of its Euler–Lagrange row and of its kinematic row (-1: none).
+    std::vector<int> rowOfFlat(m_.variables.size(), -1), kinematicRowOfFlat(m_.variables.size(), -1);
+    for (int r = 0; r < static_cast<int>(eom_.rows.size()); ++r)
+      if (int& at = rowOfFlat[eom_.rows[r].coordinate]; at < 0) at = r;
+    for (const auto& link : dae_.links)
+      if (int& at = kinematicRowOfFlat[dae_.variables[link.variable].flatVar]; at < 0) at = link.row;
+    auto rowOf = [&](const std::vector<int>& rows, Expr element) {
+      int row = rows[m_.variableOf(element)];
+      if (row < 0) QDOT_UNREACHABLE("a templated array element without its row");
+      return row;
+    };
     std::vector<int> arrays;
     for (const auto& t : eom_.templateRows) {
       const flat::ArrayVariable& a = patterns.arrays[t.array];
-      int first = rowOfFlat.at(m_.variableOf(a.elements[0]));
+      int first = rowOf(rowOfFlat, a.elements[0]);
       const flat::Variable& q = m_.variables[m_.variableOf(a.elements[0])];
       dae_.templateBlocks.push_back({first, a.shape, t.region, t.residual, flat::OriginKind::EulerLagrange, q.declRange});
       if (std::find(arrays.begin(), arrays.end(), t.array) == arrays.end()) arrays.push_back(t.array);
     }
     // Rows in the elements' order is what lets a template address them (coordinates are declared
     // element by element, so they are).
-    auto inOrder = [&](const std::unordered_map<int, int>& rowOf, const flat::ArrayVariable& a) {
-      auto first = rowOf.find(m_.variableOf(a.elements[0]));
-      for (size_t k = 0; first != rowOf.end() && k < a.elements.size(); ++k) {
-        auto it = rowOf.find(m_.variableOf(a.elements[k]));
-        if (it == rowOf.end() || it->second != first->second + static_cast<int>(k)) return false;
-      }
-      return first != rowOf.end();
+    auto inOrder = [&](const std::vector<int>& rows, const flat::ArrayVariable& a) {
+      int first = rows[m_.variableOf(a.elements[0])];
+      for (size_t k = 0; first >= 0 && k < a.elements.size(); ++k)
+        if (rows[m_.variableOf(a.elements[k])] != first + static_cast<int>(k)) return false;
+      return first >= 0;
     };
     for (int x : arrays)
       if (!inOrder(rowOfFlat, patterns.arrays[x]))
@@ -271,10 +277,10 @@ class Builder {
     for (int x : arrays) {
       const flat::ArrayVariable a = patterns.arrays[x];
       if (!inOrder(kinematicRowOfFlat, a)) continue;  // an element without inertia: scalar kinematic rows
-      int first = kinematicRowOfFlat.at(m_.variableOf(a.elements[0]));
+      int first = rowOf(kinematicRowOfFlat, a.elements[0]);
       flat::ArrayVariable rates{"$der(" + a.name + ")", a.shape, {}};
       for (Expr e : a.elements) {
-        int row = kinematicRowOfFlat.at(m_.variableOf(e));
+        int row = rowOf(kinematicRowOfFlat, e);
         rates.elements.push_back(dae_.variables[dae_.links[row - eom_.rows.size()].variable].yp);
         dae_.equations[row].residual = nullptr;
         kinematicTaken_[row - eom_.rows.size()] = 1;
