@@ -46,6 +46,29 @@ TEST(Backends, TieredModelOutlivesItsCompilation) {
   EXPECT_EQ(std::memcmp(onVm.data(), onJit.data(), onVm.size() * sizeof(double)), 0);
 }
 
+// qdot run's releaseStages: the flat model, the equations of motion, the DAE and the symbolic
+// nodes are gone once the kernels are built, the experiment is kept, the bytecode is moved into the
+// VM model — and every backend computes what it computes from a compilation that kept everything.
+TEST(Backends, ReleasedStagesChangeNoResult) {
+  const std::string text = test::readSource("examples/textbook/utube.qd");
+  for (Backend backend : {Backend::Bytecode, Backend::Native, Backend::Background}) {
+    Compilation kept, released;
+    released.options.releaseStages = true;
+    ASSERT_TRUE(compileSource(kept, "utube.qd", text, "", Stage::Kernel));
+    ASSERT_TRUE(compileSource(released, "utube.qd", text, "", Stage::Kernel));
+    EXPECT_TRUE(kept.flat && kept.eom && kept.dae);
+    EXPECT_FALSE(released.flat || released.eom || released.dae);
+    EXPECT_EQ(released.ctx.symbolCount(), sym::Context().symbolCount());
+    EXPECT_EQ(released.experiment.stopTime, kept.dae->experiment.stopTime);
+    RunnableModel a = makeRunnableModel(kept, backend, false), b = makeRunnableModel(released, backend, false);
+    ASSERT_TRUE(a.model && b.model) << a.error << b.error;
+    EXPECT_EQ(released.bytecode.has_value(), false);
+    std::vector<double> fa = residualAt(*a.model), fb = residualAt(*b.model);
+    ASSERT_EQ(fa.size(), fb.size());
+    EXPECT_EQ(std::memcmp(fa.data(), fb.data(), fa.size() * sizeof(double)), 0);
+  }
+}
+
 TEST(Backends, EachBackendSaysWhatItIs) {
   const std::string text = test::readSource("examples/textbook/utube.qd");
   for (auto [backend, what] : {std::pair{Backend::Bytecode, "bytecode"}, std::pair{Backend::Native, "llvm"}}) {

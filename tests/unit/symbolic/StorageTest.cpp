@@ -176,3 +176,27 @@ TEST(Storage, MulOperandsAreOneArray) {
 }
 
 }  // namespace
+
+// Context::clear (qdot run frees every node once the kernels are built): the Context is as new —
+// no old name is found, symbols are numbered from the start again, and what is built after it
+// simplifies and differentiates exactly as in a fresh Context.
+TEST(Storage, ClearGivesAContextAsNew) {
+  Context used, fresh;
+  for (size_t i = 0; i < 5000; ++i) used.symbol(numbered("old", i));
+  Expr x0 = used.symbol("x");
+  (void)used.diff(used.mul(x0, x0), x0);
+  used.clear();
+  EXPECT_EQ(used.findSymbol("old1"), nullptr);
+  EXPECT_EQ(used.findSymbol("x"), nullptr);
+  EXPECT_EQ(used.symbolCount(), fresh.symbolCount());
+  Expr x = used.symbol("x"), y = used.symbol("y");
+  Expr fx = fresh.symbol("x"), fy = fresh.symbol("y");
+  EXPECT_EQ(x->symbolId, fx->symbolId);
+  EXPECT_EQ(y->symbolId, fy->symbolId);
+  EXPECT_TRUE(used.zero()->isZero());
+  EXPECT_TRUE(used.one()->isOne());
+  Expr e = used.add(used.mul(x, y), used.pow(x, used.constant(3)));
+  Expr fe = fresh.add(fresh.mul(fx, fy), fresh.pow(fx, fresh.constant(3)));
+  EXPECT_EQ(used.diff(e, x)->hash, fresh.diff(fe, fx)->hash);
+  EXPECT_EQ(used.add(used.mul(x, y), used.mul(y, x)), used.scale(2, used.mul(x, y)));
+}
