@@ -518,10 +518,14 @@ void IdaSession::Impl::checkStartMatrix() {
     return;  // a failing Jacobian is reported where IDA meets it, with its message
   auto names = nameList(model.variableNames, n);
   std::vector<std::string> missing;
+  // dF/dy' is J(cj = 1) - J(cj = 0): where |dF/dy| is so large that adding 1 does not change it
+  // (a stiffness of 1e300), the difference cannot see the entry, and the column is not declared
+  // missing on its account.
+  auto unseen = [](double at0) { return at0 + 1.0 == at0 || !std::isfinite(at0); };
   for (uint32_t c = 0; c < n; ++c) {
     bool zero = true;
     for (int32_t k = model.jacobianColumnStarts[c]; k < model.jacobianColumnStarts[c + 1]; ++k)
-      zero &= (model.isDifferential[c] ? at1[k] - at0[k] : at0[k]) == 0;
+      zero &= model.isDifferential[c] ? at1[k] - at0[k] == 0 && !unseen(at0[k]) : at0[k] == 0;
     if (zero) missing.push_back(model.isDifferential[c] ? "der(" + std::string(names[c]) + ")" : std::string(names[c]));
   }
   bool dependent = missing.empty() && dummies;

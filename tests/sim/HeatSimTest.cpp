@@ -36,5 +36,15 @@ TEST(HeatRod, DecaysAsTheFirstModeOfTheSemiDiscreteSystem) {
   }
 }
 
+// A diffusivity of 1e300 makes ∂F/∂y so large that J(cj = 1) − J(cj = 0) cannot see the identity
+// ∂F/∂y': the start check must not claim that no equation contains der(T[i]) (every row does). The
+// run fails (no Newton iteration converges on eigenvalues of 1e300), saying so at t = 0.
+TEST(HeatRod, AnAbsurdStiffnessIsNotReportedAsAMissingEquation) {
+  auto r = runQdot("examples/heat/rod.qd", {"-p", "a=1e300", "--stop", "1"});
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_EQ(r.log.find("no equation contains"), std::string::npos) << r.log;
+  EXPECT_NE(r.log.find("failed at t = 0"), std::string::npos) << r.log;
+}
+
 }  // namespace
 }  // namespace qdot::simtest
