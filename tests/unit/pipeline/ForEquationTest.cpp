@@ -11,32 +11,13 @@
 #include <sstream>
 #include <vector>
 
-#include "driver/Pipeline.h"
-#include "kernel/Kernel.h"
+#include "unit/pipeline/KernelPair.h"
 
 namespace qdot {
 namespace {
 
-struct Compiled {
-  driver::Compilation c;
-  bool ok = false;
-  Compiled(const std::string& text, bool loops) {
-    c.options.keepLoops = loops;
-    ok = driver::compileSource(c, "model.qd", text, driver::Stage::Kernel);
-  }
-  const kernel::KernelModule& kernels() const { return *c.kernels; }
-  std::string diagnostics() const {
-    std::ostringstream os;
-    c.diags.render(os, c.sources);
-    return os.str();
-  }
-};
-
-size_t loopCount(const kernel::Program& p) {
-  size_t n = 0;
-  for (const auto& i : p.code) n += i.op == kernel::Op::LoopBegin;
-  return n;
-}
+using Compiled = test::CompiledKernels;
+using test::loopCount;
 
 // Per row of the scalar DAE, the unknown whose derivative it defines (`der(x) = …`): the row of a
 // templated ODE (row j defines der of unknown j).
@@ -75,23 +56,10 @@ size_t expectSameKernels(const std::string& text, size_t blocks) {
   std::vector<size_t> row = rowOfUnknown(*scalar.c.dae);
   auto ja = entries(a.description, row), jb = entries(b.description, {});
   EXPECT_EQ(ja.size(), jb.size());
-  size_t n = a.variableCount(), nnz = a.description.jacobianRowIndices.size();
-  std::vector<double> p(a.description.parameterNames.size()), given(p.size(), 0.0);
-  std::vector<uint8_t> overridden(p.size(), 0);
-  ModelCall call{.given = given.data(), .overridden = overridden.data()};
-  kernel::interpret(a.program(ModelProgram::Parameters), call, p);
+  size_t n = a.variableCount();
   for (int trial = 0; trial < 3; ++trial) {
-    std::vector<double> y(n), yp(n);
-    for (size_t j = 0; j < n; ++j) {
-      y[j] = 0.1 * std::sin(1.3 * j + trial);
-      yp[j] = 0.2 * std::cos(0.7 * j + 2 * trial);
-    }
-    ModelCall in{.t = 0.3, .cj = 17.0 + trial, .y = y.data(), .yp = yp.data(), .p = p.data()};
-    std::vector<double> fa(n), fb(n), va(nnz), vb(nnz);
-    kernel::interpret(a.program(ModelProgram::Residual), in, fa);
-    kernel::interpret(b.program(ModelProgram::Residual), in, fb);
-    kernel::interpret(a.program(ModelProgram::Jacobian), in, va);
-    kernel::interpret(b.program(ModelProgram::Jacobian), in, vb);
+    test::KernelValues A = test::evaluateAt(a, trial), B = test::evaluateAt(b, trial);
+    const std::vector<double>&fa = A.F, &fb = B.F, &va = A.J, &vb = B.J;
     for (size_t i = 0; i < n; ++i) EXPECT_NEAR(fb[row[i]], fa[i], 1e-13 * (1 + std::abs(fa[i]))) << "F[" << i << "]";
     for (const auto& [at, k] : ja) {
       auto other = jb.find(at);

@@ -7,26 +7,16 @@
 #include <cmath>
 #include <vector>
 
-#include "driver/Pipeline.h"
-#include "kernel/Kernel.h"
+#include "unit/pipeline/KernelPair.h"
 
 namespace qdot {
 namespace {
 
-struct Compiled {
-  driver::Compilation c;
-  Compiled(const std::string& text, bool loops) {
-    c.options.keepLoops = loops;
-    EXPECT_TRUE(driver::compileSource(c, "model.qd", text, driver::Stage::Kernel)) << c.internalError;
-  }
-  const kernel::KernelModule& kernels() const { return *c.kernels; }
-};
+using test::loopCount;
 
-size_t loopCount(const kernel::Program& p) {
-  size_t n = 0;
-  for (const auto& i : p.code) n += i.op == kernel::Op::LoopBegin;
-  return n;
-}
+struct Compiled : test::CompiledKernels {
+  Compiled(const std::string& text, bool loops) : CompiledKernels(text, loops) { EXPECT_TRUE(ok) << diagnostics(); }
+};
 
 // Residual and Jacobian of both at a few random states; returns the loops the templated one has.
 size_t expectSameKernels(const std::string& text) {
@@ -36,24 +26,10 @@ size_t expectSameKernels(const std::string& text) {
   EXPECT_EQ(a.description.jacobianColumnStarts, b.description.jacobianColumnStarts);
   EXPECT_EQ(a.description.jacobianRowIndices, b.description.jacobianRowIndices);
   size_t n = a.variableCount(), nnz = a.description.jacobianRowIndices.size();
-  std::vector<double> p(a.description.parameterNames.size()), given(p.size(), 0.0);
-  std::vector<uint8_t> overridden(p.size(), 0);
-  ModelCall call{.given = given.data(), .overridden = overridden.data()};
-  kernel::interpret(a.program(ModelProgram::Parameters), call, p);
   for (int trial = 0; trial < 3; ++trial) {
-    std::vector<double> y(n), yp(n);
-    for (size_t j = 0; j < n; ++j) {
-      y[j] = 0.1 * std::sin(1.3 * j + trial);
-      yp[j] = 0.2 * std::cos(0.7 * j + 2 * trial);
-    }
-    ModelCall in{.t = 0.3, .cj = 17.0 + trial, .y = y.data(), .yp = yp.data(), .p = p.data()};
-    std::vector<double> fa(n), fb(n), ja(nnz), jb(nnz);
-    kernel::interpret(a.program(ModelProgram::Residual), in, fa);
-    kernel::interpret(b.program(ModelProgram::Residual), in, fb);
-    kernel::interpret(a.program(ModelProgram::Jacobian), in, ja);
-    kernel::interpret(b.program(ModelProgram::Jacobian), in, jb);
-    for (size_t i = 0; i < n; ++i) EXPECT_NEAR(fb[i], fa[i], 1e-13 * (1 + std::abs(fa[i]))) << "F[" << i << "]";
-    for (size_t k = 0; k < nnz; ++k) EXPECT_NEAR(jb[k], ja[k], 1e-13 * (1 + std::abs(ja[k]))) << "J[" << k << "]";
+    test::KernelValues va = test::evaluateAt(a, trial), vb = test::evaluateAt(b, trial);
+    for (size_t i = 0; i < n; ++i) EXPECT_NEAR(vb.F[i], va.F[i], 1e-13 * (1 + std::abs(va.F[i]))) << "F[" << i << "]";
+    for (size_t k = 0; k < nnz; ++k) EXPECT_NEAR(vb.J[k], va.J[k], 1e-13 * (1 + std::abs(va.J[k]))) << "J[" << k << "]";
   }
   EXPECT_EQ(loopCount(a.program(ModelProgram::Residual)), 0u);
   return loopCount(b.program(ModelProgram::Residual));

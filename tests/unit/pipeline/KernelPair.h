@@ -1,0 +1,64 @@
+// Test helper for comparing a model's looped and scalar kernels (issue 15): the model compiled to
+// kernels with or without templates, and its residual and Jacobian on the reference interpreter
+// at a reproducible state per trial.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "driver/Pipeline.h"
+#include "kernel/Kernel.h"
+
+namespace qdot::test {
+
+/// `text` compiled to kernels, keeping its repeated structure as loops or not.
+struct CompiledKernels {
+  driver::Compilation c;
+  bool ok = false;
+  CompiledKernels(const std::string& text, bool loops) {
+    c.options.keepLoops = loops;
+    ok = driver::compileSource(c, "model.qd", text, driver::Stage::Kernel);
+  }
+  const kernel::KernelModule& kernels() const { return *c.kernels; }
+  std::string diagnostics() const {
+    std::ostringstream os;
+    c.diags.render(os, c.sources);
+    return os.str() + c.internalError;
+  }
+};
+
+inline size_t loopCount(const kernel::Program& p) {
+  size_t n = 0;
+  for (const auto& i : p.code) n += i.op == kernel::Op::LoopBegin;
+  return n;
+}
+
+/// The residual F and the Jacobian's values J (CSC order) of a kernel module.
+struct KernelValues {
+  std::vector<double> F, J;
+};
+
+/// F and J at trial state `trial` (y, y', cj and t fixed by it), with the default parameter values.
+inline KernelValues evaluateAt(const kernel::KernelModule& k, int trial) {
+  size_t n = k.variableCount(), nnz = k.description.jacobianRowIndices.size();
+  std::vector<double> p(k.description.parameterNames.size()), given(p.size(), 0.0);
+  std::vector<uint8_t> overridden(p.size(), 0);
+  ModelCall call{.given = given.data(), .overridden = overridden.data()};
+  kernel::interpret(k.program(ModelProgram::Parameters), call, p);
+  std::vector<double> y(n), yp(n);
+  for (size_t j = 0; j < n; ++j) {
+    y[j] = 0.1 * std::sin(1.3 * j + trial);
+    yp[j] = 0.2 * std::cos(0.7 * j + 2 * trial);
+  }
+  ModelCall in{.t = 0.3, .cj = 17.0 + trial, .y = y.data(), .yp = yp.data(), .p = p.data()};
+  KernelValues v{std::vector<double>(n), std::vector<double>(nnz)};
+  kernel::interpret(k.program(ModelProgram::Residual), in, v.F);
+  kernel::interpret(k.program(ModelProgram::Jacobian), in, v.J);
+  return v;
+}
+
+}  // namespace qdot::test
