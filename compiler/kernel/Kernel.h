@@ -42,7 +42,7 @@ using qdot::Loop;
 
 /// One instruction. Instruction i of a program defines virtual register %i (SSA); stores, loop
 /// control and `Ret` define nothing. Operands a, b, c are earlier registers; `imm` is the input
-/// index for loads (ldyl, ldypl: added to L), the constant-pool index for `ldk`, the exponent
+/// index for loads (ldyl, ldypl, ldpl: added to L), the constant-pool index for `ldk`, the exponent
 /// (int32 bits) for `powi`, the output slot for `st` (stl: added to L), the index table position
 /// for `stx` (out[indexTable[imm + c]]), the loop id for `loop` and `endloop`. A register defined
 /// inside a loop body holds that iteration's value: it is read only inside the same body.
@@ -101,8 +101,9 @@ std::string describeLocation(const SourceManager& sm, SourceRange r);
 
 /// What breaks the loop rules in `p` (loop structure, indices looped instructions reach at their
 /// loop's smallest and largest offsets, operands that are not earlier registers or are defined in
-/// another loop's body), "" if nothing. `variableCount`: the length of y and y'.
-std::string checkLoops(const Program& p, size_t variableCount);
+/// another loop's body), "" if nothing. `variableCount`: the length of y and y'; `parameterCount`:
+/// of p (ldpl).
+std::string checkLoops(const Program& p, size_t variableCount, size_t parameterCount);
 
 /// Instructions one run of `p` executes: a loop body's count times, the rest once.
 uint64_t executedInstructions(const Program& p);

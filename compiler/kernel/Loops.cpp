@@ -10,15 +10,16 @@ namespace {
 constexpr uint32_t kNone = UINT32_MAX;
 
 bool isLooped(Op op) {
-  return op == Op::LoadYLooped || op == Op::LoadYpLooped || op == Op::LoadLoopOffset || op == Op::StoreLooped ||
-         op == Op::StoreIndexed;
+  return op == Op::LoadYLooped || op == Op::LoadYpLooped || op == Op::LoadPLooped || op == Op::LoadLoopOffset ||
+         op == Op::StoreLooped || op == Op::StoreIndexed;
 }
 
 std::string at(size_t i) { return std::string(" at instruction ").append(std::to_string(i)); }
 
 class LoopChecker {
  public:
-  LoopChecker(const Program& p, size_t variables) : p_(p), variables_(variables), bodyOf_(p.code.size(), kNone) {}
+  LoopChecker(const Program& p, size_t variables, size_t parameters)
+      : p_(p), variables_(variables), parameters_(parameters), bodyOf_(p.code.size(), kNone) {}
 
   std::string check() {
     std::vector<uint8_t> used(p_.loops.size(), 0);
@@ -53,6 +54,7 @@ class LoopChecker {
     int64_t lo = int64_t{ins.imm} + range_.min, hi = int64_t{ins.imm} + range_.max;
     bool ok = true;
     if (ins.op == Op::LoadYLooped || ins.op == Op::LoadYpLooped) ok = lo >= 0 && hi < int64_t(variables_);
+    if (ins.op == Op::LoadPLooped) ok = lo >= 0 && hi < int64_t(parameters_);
     if (ins.op == Op::StoreLooped) ok = lo >= 0 && hi < int64_t{p_.outputCount};
     if (ins.op == Op::StoreIndexed) {
       uint32_t count = p_.loops[open_].count;
@@ -74,7 +76,7 @@ class LoopChecker {
   }
 
   const Program& p_;
-  size_t variables_;
+  size_t variables_, parameters_;
   std::vector<uint32_t> bodyOf_;  // per instruction: the loop whose body holds it, or kNone
   uint32_t open_ = kNone;
   bool iterates_ = false;
@@ -83,7 +85,9 @@ class LoopChecker {
 
 }  // namespace
 
-std::string checkLoops(const Program& p, size_t variableCount) { return LoopChecker(p, variableCount).check(); }
+std::string checkLoops(const Program& p, size_t variableCount, size_t parameterCount) {
+  return LoopChecker(p, variableCount, parameterCount).check();
+}
 
 uint64_t executedInstructions(const Program& p) {
   uint64_t total = 0, body = 0;

@@ -274,6 +274,7 @@ class PartLowering {
       case Op::LoopEnd: endLoop(ins); return nullptr;
       case Op::LoadYLooped: return b_.CreateLoad(dbl_, loopedPtr(callField(kY), ins.imm));
       case Op::LoadYpLooped: return b_.CreateLoad(dbl_, loopedPtr(callField(kYp), ins.imm));
+      case Op::LoadPLooped: return b_.CreateLoad(dbl_, loopedPtr(callField(kP), ins.imm));
       case Op::LoadLoopOffset: return b_.CreateSIToFP(L_, dbl_);
       case Op::StoreLooped: b_.CreateStore(A(), loopedPtr(fn_->getArg(kOut), ins.imm)); return nullptr;
       case Op::StoreIndexed: {

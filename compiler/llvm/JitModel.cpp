@@ -60,7 +60,7 @@ Status validate(const kernel::KernelModule& k) {
     if (k.programs[i].outputCount != expected)
       return Error{"kernel program " + k.programs[i].name + " writes " + std::to_string(k.programs[i].outputCount) +
                    " values, the model ABI expects " + std::to_string(expected)};
-    if (std::string e = kernel::checkLoops(k.programs[i], k.variableCount()); !e.empty())
+    if (std::string e = kernel::checkLoops(k.programs[i], k.variableCount(), k.description.parameterCount()); !e.empty())
       return Error{"kernel program " + k.programs[i].name + ": " + e};
   }
   if (std::string e = k.description.inconsistency(); !e.empty()) return Error{"kernel module: " + e};

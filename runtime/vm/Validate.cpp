@@ -12,8 +12,8 @@ namespace {
 
 // The opcodes that use the loop state (c, L), allowed only inside a loop body.
 bool isLooped(Opcode op) {
-  return op == Opcode::LoadYLooped || op == Opcode::LoadYpLooped || op == Opcode::LoadLoopOffset ||
-         op == Opcode::StoreLooped || op == Opcode::StoreIndexed;
+  return op == Opcode::LoadYLooped || op == Opcode::LoadYpLooped || op == Opcode::LoadPLooped ||
+         op == Opcode::LoadLoopOffset || op == Opcode::StoreLooped || op == Opcode::StoreIndexed;
 }
 
 // Which inputs each entry point passes (qdot/programs.def).
@@ -26,7 +26,8 @@ bool loadAllowed(ModelProgram program, Opcode op) {
     case Opcode::LoadYLooped: return inputs & InputY;
     case Opcode::LoadYp:
     case Opcode::LoadYpLooped: return inputs & InputYp;
-    case Opcode::LoadP: return inputs & InputP;
+    case Opcode::LoadP:
+    case Opcode::LoadPLooped: return inputs & InputP;
     case Opcode::LoadGiven: return inputs & InputGiven;
     case Opcode::LoadOverridden: return inputs & InputOverridden;
     default: return true;
@@ -86,7 +87,8 @@ class FunctionChecker {
       case Opcode::LoadOverridden: return i < d_.parameterCount();
       case Opcode::LoadConst: return i < f_.constants.size();
       case Opcode::LoadYLooped:
-      case Opcode::LoadYpLooped: return true;  // with the loop's offsets: loopRules
+      case Opcode::LoadYpLooped:
+      case Opcode::LoadPLooped: return true;  // with the loop's offsets: loopRules
       default: return false;
     }
   }
@@ -117,6 +119,7 @@ class FunctionChecker {
     switch (ins.op) {
       case Opcode::LoadYLooped:
       case Opcode::LoadYpLooped: return lo >= 0 && hi < int64_t(d_.variableCount()) ? "" : std::string(name) + " index out of range";
+      case Opcode::LoadPLooped: return lo >= 0 && hi < int64_t(d_.parameterCount()) ? "" : "ldpl index out of range";
       case Opcode::StoreLooped: return lo >= 0 && hi < int64_t{f_.outputCount} ? "" : "stl slot out of range";
       case Opcode::StoreIndexed: return indexedSlotsOk(ins.imm) ? "" : "stx index table position or slot out of range";
       default: return "";

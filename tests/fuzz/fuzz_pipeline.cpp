@@ -40,7 +40,7 @@ void checkKernels(const kernel::KernelModule& m, size_t unknowns) {
   for (size_t p = 0; p < kModelProgramCount; ++p) {
     const kernel::Program& program = m.programs[p];
     check(program.outputCount == m.description.outputCount(programAt(p)));
-    check(kernel::checkLoops(program, m.variableCount()).empty());
+    check(kernel::checkLoops(program, m.variableCount(), m.description.parameterCount()).empty());
     for (uint32_t i = 0; i < program.code.size(); ++i) {
       const kernel::Instr& ins = program.code[i];
       uint32_t reads = kernel::readCount(ins.op);

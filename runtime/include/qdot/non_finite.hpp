@@ -114,6 +114,7 @@ inline std::string describeProblem(const ModelDescription& d, const bc::Instruct
     case bc::Opcode::LoadYp: return "the value of der(" + nameAt(d.variableNames, ins.imm) + ") is " + v;
     case bc::Opcode::LoadYLooped: return "the value of " + nameAt(d.variableNames, looped) + " is " + v;
     case bc::Opcode::LoadYpLooped: return "the value of der(" + nameAt(d.variableNames, looped) + ") is " + v;
+    case bc::Opcode::LoadPLooped: return "parameter " + nameAt(d.parameterNames, looped) + " is " + v;
     case bc::Opcode::LoadP: return "parameter " + nameAt(d.parameterNames, ins.imm) + " is " + v;
     case bc::Opcode::LoadGiven: return "the value given for parameter " + nameAt(d.parameterNames, ins.imm) + " is " + v;
     case bc::Opcode::LoadTime: return "time is " + v;

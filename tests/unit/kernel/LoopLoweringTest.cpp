@@ -115,21 +115,45 @@ TEST_F(LoopLowering, CheckLoopsAndExecutedInstructions) {
     return b.finish(4);
   };
   kernel::Program p = build(3, 0);  // y[1 + L], L = 0..2: y[1..3]; out[0..2]
-  EXPECT_EQ(kernel::checkLoops(p, 4), "");
+  EXPECT_EQ(kernel::checkLoops(p, 4, 0), "");
   EXPECT_EQ(kernel::executedInstructions(p), 2 + 3u * 4);  // loop, endloop; 3 x (ldk, ldyl, mul, stl)
-  EXPECT_NE(kernel::checkLoops(build(4, 0), 4).find("ldyl index out of range"), std::string::npos);  // y[4]
-  EXPECT_NE(kernel::checkLoops(build(3, -2), 4).find("index out of range"), std::string::npos);      // y[-1]
-  EXPECT_EQ(kernel::checkLoops(build(0, -9), 4), "");  // no iteration reaches anything
+  EXPECT_NE(kernel::checkLoops(build(4, 0), 4, 0).find("ldyl index out of range"), std::string::npos);  // y[4]
+  EXPECT_NE(kernel::checkLoops(build(3, -2), 4, 0).find("index out of range"), std::string::npos);      // y[-1]
+  EXPECT_EQ(kernel::checkLoops(build(0, -9), 4, 0), "");  // no iteration reaches anything
   kernel::Program escaped = p;
   escaped.code.push_back({Op::Store, 3, 0, 0, 3});  // %3 (the mul, in the body) after the loop
-  EXPECT_NE(kernel::checkLoops(escaped, 4).find("is read outside it"), std::string::npos);
+  EXPECT_NE(kernel::checkLoops(escaped, 4, 0).find("is read outside it"), std::string::npos);
   kernel::Program outside = p;
   outside.code.push_back({Op::LoadLoopOffset});
-  EXPECT_NE(kernel::checkLoops(outside, 4).find("ldidx outside a loop"), std::string::npos);
+  EXPECT_NE(kernel::checkLoops(outside, 4, 0).find("ldidx outside a loop"), std::string::npos);
   kernel::Program nested = p;
   nested.loops.push_back(nested.loops[0]);
   nested.code.insert(nested.code.begin() + 1, {Op::LoopBegin, 0, 0, 0, 1});
-  EXPECT_NE(kernel::checkLoops(nested, 4).find("nested loop"), std::string::npos);
+  EXPECT_NE(kernel::checkLoops(nested, 4, 0).find("nested loop"), std::string::npos);
+}
+
+// A parameter array read in a loop (ldpl p[imm + L]) is checked against the parameters' count at
+// the loop's smallest and largest offsets, and only inside a loop.
+TEST_F(LoopLowering, CheckLoopsBoundsALoopedParameterLoad) {
+  auto build = [&](uint32_t count, int32_t first) {
+    kernel::ProgramBuilder b("residual");
+    b.bindLoopedLoad(here, Op::LoadPLooped, 2);
+    b.beginLoop(kernel::Loop{.count = count, .first = first, .stride = 1});
+    b.storeLooped(0, b.lower(ctx.mul(c(2), here)));
+    b.endLoop();
+    return b.finish(4);
+  };
+  kernel::Program p = build(3, 0);  // p[2 + L], L = 0..2: p[2..4]
+  ASSERT_EQ(count(p, Op::LoadPLooped), 1u);
+  EXPECT_EQ(kernel::checkLoops(p, 4, 5), "");
+  EXPECT_NE(kernel::checkLoops(p, 4, 4).find("ldpl index out of range"), std::string::npos);  // p[4] of 4
+  EXPECT_NE(kernel::checkLoops(build(2, -3), 4, 5).find("ldpl index out of range"), std::string::npos);  // p[-1]
+  std::vector<double> params = {0, 0, 1.5, 2.5, 3.5}, out(4, -1.0);
+  kernel::interpret(p, {.p = params.data()}, out);
+  EXPECT_EQ(out, (std::vector<double>{3.0, 5.0, 7.0, -1.0}));
+  kernel::Program outside = p;
+  outside.code.push_back({Op::LoadPLooped, 0, 0, 0, 0});
+  EXPECT_NE(kernel::checkLoops(outside, 4, 5).find("ldpl outside a loop"), std::string::npos);
 }
 
 }  // namespace

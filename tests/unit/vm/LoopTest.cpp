@@ -274,6 +274,57 @@ TEST(VmLoopValidation, RejectsAnStxSlotOutsideTheOutputs) {
   EXPECT_NE(s.error().find("stx"), std::string::npos) << s.error();
 }
 
+// F[i] = a[i + 1]*y[i] for i = 0 .. n-2: a parameter array read in a loop (ldpl p[1 + L]), n
+// parameters a0 .. a{n-1} (each its given value).
+bc::Module parameterLoop(uint32_t n) {
+  bc::Module m = loopModule(n);
+  m.description.parameterNames.clear(), m.description.parameterDescriptions.clear();
+  for (uint32_t i = 0; i < n; ++i) m.description.parameterNames.push_back("a" + std::to_string(i));
+  m.description.parameterDescriptions.assign(n, "");
+  Assembler pa(m.function(ModelProgram::Parameters), {}, 1);
+  for (uint32_t i = 0; i < n; ++i) pa.op(Opcode::LoadGiven, {pa.r(0), i}).op(Opcode::Store, {i, pa.r(0)});
+  pa.ret(n);
+  bc::Function& f = m.function(ModelProgram::Residual);
+  Assembler a(f, {0.0}, 2);
+  LoopWriter w{f, a};
+  f.loops = {Loop{.count = n - 1, .first = 0, .stride = 1}};
+  a.op(Opcode::Store, {n - 1, 0});
+  w.begin(0);
+  a.op(Opcode::LoadPLooped, {a.r(0), 1}).op(Opcode::LoadYLooped, {a.r(1), 0});
+  a.op(Opcode::Mul, {a.r(0), a.r(0), a.r(1)}).op(Opcode::StoreLooped, {0, a.r(0)});
+  w.end(0);
+  a.ret(n);
+  return m;
+}
+
+TEST(VmLoops, ALoopedParameterLoadReadsItsArrayElement) {
+  const uint32_t n = 7;
+  bc::Module m = parameterLoop(n);
+  ASSERT_TRUE(bc::validate(m)) << bc::validate(m).error();
+  Result<ModelPtr> model = vm::createModel(m);
+  ASSERT_TRUE(model.ok()) << model.error();
+  QdotModel* q = model.value().get();
+  std::vector<double> y = randomY(n), yp(n, 0.0), p(n), F(n, -99.0);
+  for (uint32_t i = 0; i < n; ++i) p[i] = 0.5 + i * i;
+  EXPECT_EQ(q->residual(q, 0, y.data(), yp.data(), p.data(), F.data()), 0);
+  for (uint32_t i = 0; i + 1 < n; ++i) EXPECT_EQ(std::bit_cast<uint64_t>(F[i]), std::bit_cast<uint64_t>(p[i + 1] * y[i])) << i;
+  EXPECT_EQ(F[n - 1], 0.0);
+}
+
+TEST(VmLoopValidation, RejectsALoopedParameterLoadOutsideTheParameters) {
+  bc::Module m = parameterLoop(5);
+  m.function(ModelProgram::Residual).code[wordOf(m.function(ModelProgram::Residual), Opcode::LoadPLooped) + 2] = 2;  // a[2 + 3]
+  Status s = bc::validate(m);
+  ASSERT_FALSE(s);
+  EXPECT_NE(s.error().find("ldpl index out of range"), std::string::npos) << s.error();
+  bc::Module outside = parameterLoop(5);
+  bc::Function& f = outside.function(ModelProgram::Parameters);
+  f.code[wordOf(f, Opcode::LoadGiven)] = uint32_t(Opcode::LoadPLooped);  // the parameters function has no p
+  s = bc::validate(outside);
+  ASSERT_FALSE(s);
+  EXPECT_NE(s.error().find("ldpl"), std::string::npos) << s.error();
+}
+
 TEST(VmLoops, ANonFiniteValueInsideALoopNamesItsIterationAndOffset) {
   bc::Module m = stencil(8);
   Result<ModelPtr> model = vm::createModel(m);
