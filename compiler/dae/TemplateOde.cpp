@@ -2,6 +2,7 @@
 // that it is one, and its unknowns and rows, row j defining the derivative of unknown j.
 #include "dae/TemplateOde.h"
 
+#include "flatten/Flatten.h"
 #include "support/Assert.h"
 
 namespace qdot::dae {
@@ -62,7 +63,8 @@ class OdeCheck {
   }
 
   // The unknown of the first element of the array whose derivatives a template `der(x)[%1,…] = rhs`
-  // defines, or -1.
+  // defines, or -1. The right side reads arrays of unknowns and of parameters (ldpl) by the
+  // template's iterators in order.
   int templateRow(const flat::EquationTemplate& t) {
     const flat::RelativeElement* own = m_.relativeElement(t.lhs);
     if (!own || !indexedInOrder(*own, t.box.size())) return -1;
@@ -72,6 +74,7 @@ class OdeCheck {
     int first = firstOfConsecutive(rates, [&](Expr e) { return unknownOfRate(m_, e); });
     for (Expr s : ctx_.freeSymbols(t.rhs)) {
       if (const flat::RelativeElement* rel = m_.relativeElement(s)) {
+        if (flat::loopableParameters(m_, *rel, t.box.size(), rates.shape)) continue;
         const flat::ArrayVariable& a = m_.patterns->arrays[rel->array];
         bool shaped = t.box.size() == 1 || a.shape == rates.shape;
         if (!indexedInOrder(*rel, t.box.size()) || !shaped || firstUnknown(rel->array) < 0) return -1;

@@ -66,23 +66,41 @@ bool check(Compilation& c) {
   return c.checked && !c.diags.hasErrors();
 }
 
+// Whether every relative symbol of the sum is one the loops read: an array of coordinates or
+// velocities, or an array of parameters a loop addresses as p[first + linear index]
+// (flat::loopableParameters; in several dimensions of the shape of the coordinates the sum reads).
+bool loopsReadSum(const flat::FlatModel& m, const flat::IndexedSum& sum, const sym::Context& ctx) {
+  std::vector<const flat::RelativeElement*> parameters;
+  const std::vector<int>* shape = nullptr;  // of the sum's moving arrays
+  for (sym::Expr s : ctx.freeSymbols(sum.body)) {
+    const flat::RelativeElement* rel = m.relativeElement(s);
+    if (!rel) continue;
+    const flat::ArrayVariable& a = m.patterns->arrays[rel->array];
+    int var = m.variableOf(a.elements[0]);
+    flat::VarRole role = var >= 0 ? m.variables[var].role : flat::VarRole::Parameter;
+    if (var >= 0 && (role == flat::VarRole::Coordinate || role == flat::VarRole::Velocity)) {
+      if (shape && *shape != a.shape) return false;
+      shape = &a.shape;
+    } else {
+      parameters.push_back(rel);
+    }
+  }
+  return std::all_of(parameters.begin(), parameters.end(), [&](const flat::RelativeElement* rel) {
+    return shape && flat::loopableParameters(m, *rel, sum.box.size(), *shape);
+  });
+}
+
 // Where the stages after flattening take templates (docs/loops.md): a model of energies over
 // coordinates only — no equations, constraints, components or aliases (their structural passes
 // work on scalars) — and a run that needs no invariants (a sum over every element).
-// The loops read unknowns only: a template over an array of parameters (masses[i]) stays scalar.
 bool templatesApply(const flat::FlatModel& m, const CompileOptions& o, const sym::Context& ctx) {
   if (!o.keepLoops || m.indexedSums.empty() || o.keepInvariants) return false;
   if (!m.equations.empty() || !m.initialEquations.empty() || !m.constraints.empty() || m.components.size() > 1) return false;
   bool plain = std::none_of(m.variables.begin(), m.variables.end(), [](const flat::Variable& v) {
     return v.alias || v.role == flat::VarRole::Unknown || v.role == flat::VarRole::Derivative;
   });
-  for (const flat::IndexedSum& sum : m.indexedSums)
-    for (sym::Expr s : ctx.freeSymbols(sum.body))
-      if (const flat::RelativeElement* rel = m.relativeElement(s)) {
-        int var = m.variableOf(m.patterns->arrays[rel->array].elements[0]);
-        plain = plain && var >= 0 && (m.variables[var].role == flat::VarRole::Coordinate || m.variables[var].role == flat::VarRole::Velocity);
-      }
-  return plain;
+  return plain && std::all_of(m.indexedSums.begin(), m.indexedSums.end(),
+                              [&](const flat::IndexedSum& sum) { return loopsReadSum(m, sum, ctx); });
 }
 
 // Gives the pages of freed blocks back to the system, so that what the solver allocates next

@@ -44,4 +44,11 @@ sym::Expr instantiate(const FlatModel& model, sym::Context& ctx, sym::Expr body,
 /// keepLoops gives) and clears the templates.
 void expandIndexedSums(FlatModel& model, sym::Context& ctx);
 
+/// Whether a loop can read relative symbol `rel` of a template over `rank` iterators, whose rows are
+/// laid out in an array of `shape`, as the parameter p[first + the row's linear index + offset]:
+/// every element of its array a parameter, the elements consecutive variables (the DAE numbers
+/// parameters in variable order), subscript d the template's iterator d plus a constant, and in
+/// more than one dimension the array of that shape. Otherwise the template stays scalar.
+bool loopableParameters(const FlatModel& m, const RelativeElement& rel, size_t rank, std::span<const int> shape);
+
 }  // namespace qdot::flat

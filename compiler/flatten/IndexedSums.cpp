@@ -418,6 +418,20 @@ Expr instantiate(const FlatModel& model, sym::Context& ctx, Expr body, std::span
   return ctx.substitute(body, map);
 }
 
+bool loopableParameters(const FlatModel& m, const RelativeElement& rel, size_t rank, std::span<const int> shape) {
+  const ArrayVariable& a = m.patterns->arrays[rel.array];
+  if (rel.dims.size() != rank || a.elements.empty()) return false;
+  if (rank > 1 && !std::equal(a.shape.begin(), a.shape.end(), shape.begin(), shape.end())) return false;
+  for (size_t d = 0; d < rank; ++d)
+    if (rel.dims[d].iterator != static_cast<int>(d)) return false;
+  int first = m.variableOf(a.elements[0]);
+  for (size_t k = 0; k < a.elements.size(); ++k) {
+    int var = m.variableOf(a.elements[k]);
+    if (first < 0 || var != first + static_cast<int>(k) || m.variables[var].role != VarRole::Parameter) return false;
+  }
+  return true;
+}
+
 void expandIndexedSums(FlatModel& model, sym::Context& ctx) {
   for (const IndexedSum& sum : model.indexedSums) {
     std::vector<Expr> parts;

@@ -140,25 +140,68 @@ ElementBase unknownsRead(const dae::TemplateBlock& block, const flat::RelativeEl
   return base.value_or(ElementBase{0, false});
 }
 
-// Per template block, its relative symbols with where they are read (every relative symbol of a
-// templated DAE is an unknown's: the pipeline keeps templates only then).
+// The parameter index of the first element of an array whose element k is parameter first + k
+// (ldpl reads p[first + linear index]), or -1. `parameterOf`: by symbol id, the parameter or -1.
+int parameterBase(const flat::ArrayVariable& a, const std::vector<int>& parameterOf) {
+  auto of = [&](sym::Expr e) { return e->isSymbol() && e->symbolId < parameterOf.size() ? parameterOf[e->symbolId] : -1; };
+  int first = a.elements.empty() ? -1 : of(a.elements[0]);
+  for (size_t k = 1; first >= 0 && k < a.elements.size(); ++k)
+    if (of(a.elements[k]) != first + static_cast<int>(k)) return -1;
+  return first;
+}
+
+// Subscript d is the block's iterator d plus a constant, and the array has the block's strides (its
+// shape in more than one dimension): element index = the block's linear index + the offset.
+bool loopsAlong(const flat::RelativeElement& rel, const flat::ArrayVariable& a, const dae::TemplateBlock& block) {
+  if (rel.dims.size() != block.shape.size() || (rel.dims.size() > 1 && a.shape != block.shape)) return false;
+  for (size_t d = 0; d < rel.dims.size(); ++d)
+    if (rel.dims[d].iterator != static_cast<int>(d)) return false;
+  return true;
+}
+
+// Per symbol id, the index of the parameter it is (-1: none); empty without template blocks.
+std::vector<int> parameterIndices(const dae::Dae& dae) {
+  std::vector<int> of;
+  if (!dae.templated()) return of;
+  for (size_t k = 0; k < dae.parameters.size(); ++k) {
+    uint32_t id = dae.parameters[k].symbol->symbolId;
+    if (of.size() <= id) of.resize(id + 1, -1);
+    of[id] = static_cast<int>(k);
+  }
+  return of;
+}
+
+// Per template block, its relative symbols with where they are read: an array of unknowns, or of
+// parameters consecutive in p, indexed by the block's iterators in order (of the block's shape in
+// more than one dimension) — the pipeline keeps templates only then.
 std::vector<std::vector<TemplateOperand>> templateOperands(const dae::Dae& dae, const sym::Context& ctx,
                                                            const UnknownSymbols& unknowns) {
   std::vector<std::vector<TemplateOperand>> out(dae.templateBlocks.size());
   size_t arrays = out.empty() ? 0 : dae.patterns->arrays.size();
+  std::vector<int> parameterOf = parameterIndices(dae);
   std::vector<char> looked(arrays, 0);
   std::vector<std::optional<ElementBase>> uniform(arrays);
+  std::vector<int> parameters(arrays, -1);
   for (size_t b = 0; b < out.size(); ++b) {
     const dae::TemplateBlock& block = dae.templateBlocks[b];
     for (sym::Expr s : ctx.freeSymbols(block.residual)) {
       const flat::RelativeElement* rel = dae.patterns->find(s);
       if (!rel) continue;
       const flat::ArrayVariable& a = dae.patterns->arrays[rel->array];
-      if (!looked[rel->array]) looked[rel->array] = 1, uniform[rel->array] = uniformBase(a, unknowns);
-      auto [variable, derivative] = uniform[rel->array] ? *uniform[rel->array] : unknownsRead(block, *rel, a, unknowns);
+      if (!looked[rel->array]) {
+        looked[rel->array] = 1;
+        parameters[rel->array] = parameterBase(a, parameterOf);
+        if (parameters[rel->array] < 0) uniform[rel->array] = uniformBase(a, unknowns);
+      }
       long offset = 0;
       for (size_t d = 0; d < rel->dims.size(); ++d) offset = offset * block.shape[d] + rel->dims[d].offset;
-      out[b].push_back({s, variable, derivative, offset});
+      if (int first = parameters[rel->array]; first >= 0) {
+        QDOT_ASSERT(loopsAlong(*rel, a, block), "a template reads a parameter array across its iterators");
+        out[b].push_back({s, first, false, true, offset});
+        continue;
+      }
+      auto [variable, derivative] = uniform[rel->array] ? *uniform[rel->array] : unknownsRead(block, *rel, a, unknowns);
+      out[b].push_back({s, variable, derivative, false, offset});
     }
   }
   return out;
@@ -170,6 +213,7 @@ void templateEntries(const dae::Dae& dae, sym::Context& ctx, sym::Expr cj, size_
   const dae::TemplateBlock& block = dae.templateBlocks[b];
   size_t first = out.size();
   for (const TemplateOperand& op : operands) {
+    if (op.parameter) continue;
     sym::Expr d = ctx.diff(block.residual, op.symbol);
     if (d->isZero()) continue;
     if (op.derivative) d = ctx.mul(cj, d);

@@ -9,11 +9,13 @@
 namespace qdot::kernel {
 
 /// How a relative symbol of a template block is read: the unknown of its array's element with
-/// linear index 0 (y or y'), and the linear offset of its pattern (Σ offset_d · stride_d).
+/// linear index 0 (y or y'), or for an array of parameters that element's parameter (p), and the
+/// linear offset of its pattern (Σ offset_d · stride_d).
 struct TemplateOperand {
   sym::Expr symbol = nullptr;
-  int variable = -1;
+  int variable = -1;        ///< an unknown, or with `parameter` an index into p
   bool derivative = false;  ///< y' (else y)
+  bool parameter = false;   ///< p (a constant of the rows: no Jacobian column)
   long offset = 0;
 };
 

@@ -503,7 +503,7 @@ class Builder {
     long base = flat::linearIndex(block.shape, lo);
     const std::vector<Operand>& operands = jac.templateOperands[k];
     for (const auto& op : operands)
-      b.bindLoopedLoad(op.symbol, op.derivative ? Op::LoadYpLooped : Op::LoadYLooped,
+      b.bindLoopedLoad(op.symbol, op.parameter ? Op::LoadPLooped : op.derivative ? Op::LoadYpLooped : Op::LoadYLooped,
                        static_cast<uint32_t>(op.variable + base + op.offset));
     for (const auto& [t, value] : cse.temporaries) b.bindTemporary(t, value);
     for (Expr t : invariantTemporaries(cse, operands)) b.lower(t);

@@ -26,7 +26,8 @@ class ProgramBuilder {
   /// Each unknown's y and y' read input y[j] and yp[j] (Op::LoadY, Op::LoadYp), j its variable;
   /// bindLoad wins over this. The table is shared, not copied: it must outlive the builder.
   void bindUnknowns(const UnknownSymbols& unknowns) { unknowns_ = &unknowns; }
-  /// `symbol` reads y[index + L] (Op::LoadYLooped) or yp[index + L] (Op::LoadYpLooped) inside loops.
+  /// `symbol` reads y[index + L] (Op::LoadYLooped), yp[index + L] (Op::LoadYpLooped) or p[index + L]
+  /// (Op::LoadPLooped) inside loops.
   void bindLoopedLoad(sym::Expr symbol, Op load, uint32_t index) { bindLoad(symbol, load, index); }
   /// `symbol` is the loop offset L as a number (ldidx).
   void bindLoopOffset(sym::Expr symbol) { bindLoad(symbol, Op::LoadLoopOffset, 0); }
