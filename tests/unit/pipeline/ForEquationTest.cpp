@@ -44,7 +44,7 @@ std::map<std::pair<size_t, size_t>, size_t> entries(const ModelDescription& d, c
 // The model compiled with and without templates: the templated one is a templated ODE with
 // `blocks` template blocks, and both give the same residual and Jacobian (rows matched by the
 // derivative they define) at a few random states. Returns the residual's loops.
-size_t expectSameKernels(const std::string& text, size_t blocks) {
+size_t expectSameKernels(const std::string& text, size_t blocks, const test::GivenParameters& given = {}) {
   Compiled scalar(text, false), looped(text, true);
   EXPECT_TRUE(scalar.ok && looped.ok) << scalar.diagnostics() << looped.diagnostics();
   if (!scalar.ok || !looped.ok) return 0;
@@ -58,7 +58,7 @@ size_t expectSameKernels(const std::string& text, size_t blocks) {
   EXPECT_EQ(ja.size(), jb.size());
   size_t n = a.variableCount();
   for (int trial = 0; trial < 3; ++trial) {
-    test::KernelValues A = test::evaluateAt(a, trial), B = test::evaluateAt(b, trial);
+    test::KernelValues A = test::evaluateAt(a, trial, given), B = test::evaluateAt(b, trial, given);
     const std::vector<double>&fa = A.F, &fb = B.F, &va = A.J, &vb = B.J;
     for (size_t i = 0; i < n; ++i) EXPECT_NEAR(fb[row[i]], fa[i], 1e-13 * (1 + std::abs(fa[i]))) << "F[" << i << "]";
     for (const auto& [at, k] : ja) {
@@ -152,6 +152,42 @@ end Wave;
 )", 2), 2u);
 }
 
+// --- arrays of parameters read in loops (ldpl) ---
+
+// A rod whose conductance varies along it, a[i] computed from another parameter.
+constexpr const char* kVaryingRod = R"(model VaryingRod
+  parameter Integer n = 9;
+  parameter Real a0 = 1.7;
+  parameter Real a[n] = {a0*(1 + 0.5*sin(i)) for i in 1:n};
+  Real T[n](start = {sin(3.14159265358979*i/(n + 1)) for i in 1:n});
+equation
+  der(T[1]) = a[1]*(T[2] - 2*T[1]);
+  for i in 2:n-1 loop
+    der(T[i]) = a[i]*(T[i+1] - 2*T[i] + T[i-1]) - 0.1*a[i-1]*T[i];
+  end for;
+  der(T[n]) = a[n]*(T[n-1] - 2*T[n]);
+end VaryingRod;
+)";
+
+TEST(ForEquations, RodWithVaryingConductanceReadsItInTheLoop) {
+  EXPECT_EQ(expectSameKernels(kVaryingRod, 1), 1u);
+  EXPECT_EQ(expectSameKernels(kVaryingRod, 1, {{"a0", 0.3}, {"a[4]", 5.0}}), 1u);
+  Compiled looped(kVaryingRod, true);
+  EXPECT_EQ(test::opCount(looped.kernels().program(ModelProgram::Residual), kernel::Op::LoadPLooped), 2u);  // a[%1], a[%1-1]
+  EXPECT_EQ(test::opCount(looped.kernels().program(ModelProgram::Jacobian), kernel::Op::LoadPLooped), 2u);
+}
+
+TEST(ForEquations, PlateWithATwoDimensionalParameterArrayReadsItInTheLoop) {
+  std::string text = plate(R"(  for i in 2:n-1, j in 2:m-1 loop
+    der(T[i, j]) = kap[i, j]*(T[i+1, j] + T[i-1, j] + T[i, j+1] + T[i, j-1] - 4*T[i, j]) - kap[i+1, j-1]*T[i, j]^2;
+  end for;)");
+  text.replace(text.find("  Real T[n, m]"), 0, "  parameter Real kap[n, m] = {{a + 0.1*i*j for j in 1:m} for i in 1:n};\n");
+  EXPECT_EQ(expectSameKernels(text, 1), 1u);
+  EXPECT_EQ(expectSameKernels(text, 1, {{"a", 2.0}, {"kap[3,3]", -1.0}}), 1u);
+  Compiled looped(text, true);
+  EXPECT_EQ(test::opCount(looped.kernels().program(ModelProgram::Residual), kernel::Op::LoadPLooped), 2u);
+}
+
 // Compiled with templates allowed, the model is compiled exactly as without: same kernels, no loop.
 void expectScalarFallback(const std::string& text) {
   Compiled scalar(text, false), looped(text, true);
@@ -162,6 +198,16 @@ void expectScalarFallback(const std::string& text) {
   kernel::printKernels(b, looped.kernels());
   EXPECT_EQ(a.str(), b.str());
   EXPECT_EQ(loopCount(looped.kernels().program(ModelProgram::Residual)), 0u);
+}
+
+// A parameter array a loop cannot address (another shape than the plate's, iterators out of order)
+// keeps the model scalar.
+TEST(ForEquations, ParameterArraysALoopCannotAddressKeepTheModelScalar) {
+  for (const char* read : {"kap[i, j]", "kap[j, i]"}) {
+    std::string text = plate("  for i in 2:n-1, j in 2:m-1 loop\n    der(T[i, j]) = " + std::string(read) + "*T[i+1, j];\n  end for;");
+    text.replace(text.find("  Real T[n, m]"), 0, "  parameter Real kap[n + 1, n + 1] = {{i - j for j in 1:n + 1} for i in 1:n + 1};\n");
+    expectScalarFallback(text);
+  }
 }
 
 TEST(ForEquations, AnAlgebraicUnknownKeepsTheModelScalar) {

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -31,22 +32,36 @@ struct CompiledKernels {
   }
 };
 
-inline size_t loopCount(const kernel::Program& p) {
+/// How many instructions of `p` are `op`.
+inline size_t opCount(const kernel::Program& p, kernel::Op op) {
   size_t n = 0;
-  for (const auto& i : p.code) n += i.op == kernel::Op::LoopBegin;
+  for (const auto& i : p.code) n += i.op == op;
   return n;
 }
+
+inline size_t loopCount(const kernel::Program& p) { return opCount(p, kernel::Op::LoopBegin); }
+
+/// Parameter values given at run time (as `qdot run -p name=value` gives them), by name.
+using GivenParameters = std::vector<std::pair<std::string, double>>;
 
 /// The residual F and the Jacobian's values J (CSC order) of a kernel module.
 struct KernelValues {
   std::vector<double> F, J;
 };
 
-/// F and J at trial state `trial` (y, y', cj and t fixed by it), with the default parameter values.
-inline KernelValues evaluateAt(const kernel::KernelModule& k, int trial) {
+/// F and J at trial state `trial` (y, y', cj and t fixed by it), with the default parameter values
+/// except those `given`.
+inline KernelValues evaluateAt(const kernel::KernelModule& k, int trial, const GivenParameters& givenValues = {}) {
   size_t n = k.variableCount(), nnz = k.description.jacobianRowIndices.size();
-  std::vector<double> p(k.description.parameterNames.size()), given(p.size(), 0.0);
+  const std::vector<std::string>& names = k.description.parameterNames;
+  std::vector<double> p(names.size()), given(p.size(), 0.0);
   std::vector<uint8_t> overridden(p.size(), 0);
+  for (const auto& [name, value] : givenValues) {
+    auto at = std::find(names.begin(), names.end(), name);
+    EXPECT_NE(at, names.end()) << "no parameter " << name;
+    if (at == names.end()) continue;
+    given[at - names.begin()] = value, overridden[at - names.begin()] = 1;
+  }
   ModelCall call{.given = given.data(), .overridden = overridden.data()};
   kernel::interpret(k.program(ModelProgram::Parameters), call, p);
   std::vector<double> y(n), yp(n);

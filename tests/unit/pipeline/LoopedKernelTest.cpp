@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <sstream>
 #include <vector>
 
 #include "unit/pipeline/KernelPair.h"
@@ -18,8 +19,9 @@ struct Compiled : test::CompiledKernels {
   Compiled(const std::string& text, bool loops) : CompiledKernels(text, loops) { EXPECT_TRUE(ok) << diagnostics(); }
 };
 
-// Residual and Jacobian of both at a few random states; returns the loops the templated one has.
-size_t expectSameKernels(const std::string& text) {
+// Residual and Jacobian of both at a few random states (parameters at their defaults except those
+// `given`); returns the loops the templated one has.
+size_t expectSameKernels(const std::string& text, const test::GivenParameters& given = {}) {
   Compiled scalar(text, false), looped(text, true);
   const kernel::KernelModule &a = scalar.kernels(), &b = looped.kernels();
   EXPECT_EQ(a.description.variableNames, b.description.variableNames);
@@ -27,7 +29,7 @@ size_t expectSameKernels(const std::string& text) {
   EXPECT_EQ(a.description.jacobianRowIndices, b.description.jacobianRowIndices);
   size_t n = a.variableCount(), nnz = a.description.jacobianRowIndices.size();
   for (int trial = 0; trial < 3; ++trial) {
-    test::KernelValues va = test::evaluateAt(a, trial), vb = test::evaluateAt(b, trial);
+    test::KernelValues va = test::evaluateAt(a, trial, given), vb = test::evaluateAt(b, trial, given);
     for (size_t i = 0; i < n; ++i) EXPECT_NEAR(vb.F[i], va.F[i], 1e-13 * (1 + std::abs(va.F[i]))) << "F[" << i << "]";
     for (size_t k = 0; k < nnz; ++k) EXPECT_NEAR(vb.J[k], va.J[k], 1e-13 * (1 + std::abs(va.J[k]))) << "J[" << k << "]";
   }
@@ -118,6 +120,106 @@ end Chain;
   for (size_t i = 1; i <= 50; ++i) EXPECT_EQ(out[i - 1], 0.01 * static_cast<double>(i)) << "x[" << i << "]";
   EXPECT_EQ(out[50], 0.3);
   for (size_t j = n; j < 3 * n; ++j) EXPECT_EQ(out[j], 0.0) << j;
+}
+
+// --- arrays of parameters read in loops (ldpl) ---
+
+// Parameter loads inside the loop bodies of a program.
+size_t loopedParameterLoads(const kernel::Program& p) { return test::opCount(p, kernel::Op::LoadPLooped); }
+
+constexpr const char* kNonUniformChain = R"(model NonUniformChain
+  parameter Integer n = 10;
+  parameter Real m[n] = {1 + 0.5*sin(i) for i in 1:n};
+  parameter Real k[n] = fill(1000, n);
+  parameter Real c = 0.5;
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+mechanics
+  kinetic = sum(0.5*m[i]*der(x[i])^2 for i in 1:n);
+  potential = 0.5*k[1]*x[1]^2 + sum(0.5*k[i+1]*(x[i+1] - x[i])^2 for i in 1:n-1);
+  dissipation = sum(0.5*c*(der(x[i+1]) - der(x[i]))^2 for i in 1:n-1);
+end NonUniformChain;
+)";
+
+TEST(LoopedKernels, NonUniformChainReadsItsParameterArraysInTheLoop) {
+  EXPECT_EQ(expectSameKernels(kNonUniformChain), 2u);  // the interior's rows and the kinematic rows
+  Compiled looped(kNonUniformChain, true);
+  const kernel::KernelModule& k = looped.kernels();
+  EXPECT_EQ(loopedParameterLoads(k.program(ModelProgram::Residual)), 3u);  // m[%1], k[%1], k[%1+1]
+  EXPECT_GE(loopedParameterLoads(k.program(ModelProgram::Jacobian)), 2u);  // m[%1] (cj·m), k[%1] + k[%1+1]
+  EXPECT_EQ(k.description.parameterNames.size(), 21u);  // ldpl reads the p vector qdot run fills
+}
+
+// Values given at run time to an element (`-p m[3]=…`) and to a parameter the arrays' bindings use
+// reach the loop: p is computed as before, the loop only reads it.
+TEST(LoopedKernels, GivenElementsAndBindingsOverParametersReachTheLoop) {
+  const char* text = R"(model Bound
+  parameter Integer n = 8;
+  parameter Real m0 = 2, k0 = 300;
+  parameter Real m[n] = fill(m0, n);
+  parameter Real k[n] = {k0*(1 + 0.1*i) for i in 1:n};
+  coordinate Real x[n](start = {0.02*i for i in 1:n});
+mechanics
+  kinetic = sum(0.5*m[i]*der(x[i])^2 for i in 1:n);
+  potential = sum(0.5*k[i]*(x[i+1] - x[i])^2 + 0.01*k[i]*x[i]^4 for i in 1:n-1) + 0.5*k0*x[1]^2;
+end Bound;
+)";
+  EXPECT_GE(expectSameKernels(text), 2u);
+  EXPECT_GE(expectSameKernels(text, {{"m0", 3.5}, {"k[4]", 7.0}, {"m[2]", 0.25}}), 2u);
+  // The given values change the residual: the comparison above is not of two unchanged kernels.
+  Compiled looped(text, true);
+  test::KernelValues plain = test::evaluateAt(looped.kernels(), 0), given = test::evaluateAt(looped.kernels(), 0, {{"k[4]", 7.0}});
+  EXPECT_NE(plain.F, given.F);
+}
+
+TEST(LoopedKernels, GridWithTwoDimensionalParameterArraysReadsThemInTheLoops) {
+  const char* text = R"(model Grid
+  parameter Integer n = 6, m = 5;
+  parameter Real mass[n, m] = {{1 + 0.1*i + 0.05*j for j in 1:m} for i in 1:n};
+  parameter Real k[n, m] = {{10 + sin(i*j) for j in 1:m} for i in 1:n};
+  parameter Real c = 0.1;
+  coordinate Real z[n, m](start = {{0.01*i*j for j in 1:m} for i in 1:n});
+mechanics
+  kinetic = sum(0.5*mass[i, j]*der(z[i, j])^2 for i in 1:n, j in 1:m);
+  potential = sum(0.5*k[i+1, j]*(z[i+1, j] - z[i, j])^2 for i in 1:n-1, j in 1:m)
+            + sum(0.5*k[i, j]*(z[i, j+1] - z[i, j])^2 + 0.1*k[i, j]*z[i, j]^4 for i in 1:n, j in 1:m-1);
+  dissipation = sum(0.5*c*(der(z[i+1, j]) - der(z[i, j]))^2 for i in 1:n-1, j in 1:m);
+end Grid;
+)";
+  EXPECT_EQ(expectSameKernels(text), 6u);  // 5 regions of Euler–Lagrange rows and the kinematic rows
+  EXPECT_EQ(expectSameKernels(text, {{"mass[3,2]", 4.0}, {"k[2,4]", 1.5}}), 6u);
+  Compiled looped(text, true);
+  EXPECT_GE(loopedParameterLoads(looped.kernels().program(ModelProgram::Residual)), 5u);
+}
+
+// Compiled with templates allowed, the model compiles exactly as without: the same kernels, no loop.
+void expectScalarFallback(const std::string& text) {
+  Compiled scalar(text, false), looped(text, true);
+  std::ostringstream a, b;
+  kernel::printKernels(a, scalar.kernels());
+  kernel::printKernels(b, looped.kernels());
+  EXPECT_EQ(a.str(), b.str());
+  EXPECT_EQ(loopCount(looped.kernels().program(ModelProgram::Residual)), 0u);
+}
+
+// What a loop cannot address as p[first + the row's index] keeps the model scalar: an array indexed
+// by the iterators out of order, an array of one dimension in a template of two, an array of
+// another shape than the coordinates', constant subscripts.
+TEST(LoopedKernels, ParameterArraysALoopCannotAddressKeepTheModelScalar) {
+  auto grid = [](const std::string& declaration, const std::string& factor) {
+    return R"(model Grid
+  parameter Integer n = 4, m = 4;
+  )" + declaration + R"(
+  coordinate Real z[n, m](start = {{0.01*i*j for j in 1:m} for i in 1:n});
+mechanics
+  kinetic = sum(0.5*der(z[i, j])^2 for i in 1:n, j in 1:m);
+  potential = sum()" + factor + R"(*(z[i, j+1] - z[i, j])^2 for i in 1:n, j in 1:m-1);
+end Grid;
+)";
+  };
+  expectScalarFallback(grid("parameter Real w[n, m] = {{i + 2*j for j in 1:m} for i in 1:n};", "w[j, i]"));
+  expectScalarFallback(grid("parameter Real w[n] = {1 + i for i in 1:n};", "w[i]"));
+  expectScalarFallback(grid("parameter Real w[n + 1, m] = {{i + 2*j for j in 1:m} for i in 1:n + 1};", "w[i, j]"));
+  expectScalarFallback(grid("parameter Real w[n, m] = {{i + 2*j for j in 1:m} for i in 1:n};", "w[2, j]"));
 }
 
 TEST(LoopedKernels, PendulumWithoutRepeatedStructureHasNoLoops) {
