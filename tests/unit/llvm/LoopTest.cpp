@@ -3,7 +3,8 @@
 // values from before a loop cross parts) give the same bits as the direct C++ computation — an
 // affine stencil with peeled ends and invariant registers, count 0 and 1, a table loop storing
 // through a permutation (stx) with ldidx, negative strides, a value from before a loop used after
-// it. A NaN inside a loop is named with its iteration on the VM and on the JIT.
+// it, a parameter array read with ldpl. A NaN inside a loop is named with its iteration on the VM
+// and on the JIT.
 #include <cstdio>
 #include <functional>
 #include <random>
@@ -172,6 +173,49 @@ TEST(Loops, NegativeStrideAndTwoLoopsOnEveryBackend) {
     for (uint32_t L = n - 1; L >= 3; --L) F[L] = 0.01 * double(L) + yp[L];
     for (uint32_t L = 0; L < 3; ++L) F[L] = 0.01 * y[L];
   });
+}
+
+// A parameter array read in a loop (ldpl): F[L] = a[L + 1]*y[L] + a[L]*yp[L] for L = 0 .. n-2, and
+// F[n-1] = k·y[n-1] with k = a[0] read before the loop, n parameters a0 .. a{n-1}; the same bits on
+// interpret, the VM and the JIT (O2 whole, O0 split every 3 instructions).
+TEST(Loops, AParameterArrayReadInALoopOnEveryBackend) {
+  const uint32_t n = 9;
+  Writer w;
+  uint32_t k = w.op(Op::LoadP);
+  w.loop(Loop{.count = n - 1});
+  uint32_t right = w.op(Op::Mul, w.op(Op::LoadPLooped, 0, 0, 0, 1), w.op(Op::LoadYLooped));
+  w.op(Op::StoreLooped, w.op(Op::Add, right, w.op(Op::Mul, w.op(Op::LoadPLooped), w.op(Op::LoadYpLooped))));
+  w.endLoop();
+  w.op(Op::Store, w.op(Op::Mul, k, w.op(Op::LoadY, 0, 0, 0, n - 1)), 0, 0, n - 1);
+  kernel::KernelModule m = moduleWith(w.p, n);
+  m.description.parameterNames.clear();
+  kernel::Program& params = m.program(ModelProgram::Parameters);
+  params.code.clear();
+  for (uint32_t i = 0; i < n; ++i) {
+    m.description.parameterNames.push_back("a" + std::to_string(i));
+    params.code.push_back(Instr{Op::LoadGiven, 0, 0, 0, i});
+    params.code.push_back(Instr{Op::Store, 2 * i, 0, 0, i});
+  }
+  m.description.parameterDescriptions.assign(n, "");
+  params.outputCount = n;
+  ASSERT_EQ(kernel::checkLoops(m.program(ModelProgram::Residual), n, n), "");
+  Inputs in(n);
+  std::vector<double> a(n), want(n), got(n);
+  for (uint32_t i = 0; i < n; ++i) a[i] = 0.5 + 0.25 * i * i;
+  for (uint32_t L = 0; L + 1 < n; ++L) want[L] = a[L + 1] * in.y[L] + a[L] * in.yp[L];
+  want[n - 1] = a[0] * in.y[n - 1];
+  kernel::interpret(m.program(ModelProgram::Residual), {.y = in.y.data(), .yp = in.yp.data(), .p = a.data()}, got);
+  expectSame(got, want, "interpret");
+  auto run = [&](Result<ModelPtr> model, const std::string& who) {
+    ASSERT_TRUE(model.ok()) << who << ": " << model.error();
+    QdotModel* q = model.value().get();
+    std::fill(got.begin(), got.end(), -123.0);
+    EXPECT_EQ(q->residual(q, 0, in.y.data(), in.yp.data(), a.data(), got.data()), 0) << q->lastError(q);
+    expectSame(got, want, who);
+  };
+  run(vmModel(m), "vm");
+  run(jitModel(m, 2, 5000), "jit O2");
+  run(jitModel(m, 0, 3), "jit O0 split");
 }
 
 TEST(Loops, ANaNInsideALoopIsNamedWithItsIterationOnTheVmAndTheJit) {

@@ -1,5 +1,6 @@
 // Loops in bytecode written by hand: the VM runs affine and table loops (peeled stencil ends,
-// count 0 and 1, invariant registers, stx through a permutation, ldidx, negative offsets) exactly
+// count 0 and 1, invariant registers, stx through a permutation, ldidx, negative offsets, a
+// parameter array read with ldpl) exactly
 // as the direct C++ computation; modules with loops survive serialisation; the validator rejects
 // every broken loop rule; a non-finite value inside a loop is named with its iteration and offset.
 #include <gtest/gtest.h>
