@@ -203,7 +203,7 @@ void expectScalarFallback(const std::string& text) {
 
 // What a loop cannot address as p[first + the row's index] keeps the model scalar: an array indexed
 // by the iterators out of order, an array of one dimension in a template of two, an array of
-// another shape than the coordinates', constant subscripts.
+// another shape than the coordinates', constant subscripts, an array of constants.
 TEST(LoopedKernels, ParameterArraysALoopCannotAddressKeepTheModelScalar) {
   auto grid = [](const std::string& declaration, const std::string& factor) {
     return R"(model Grid
@@ -220,6 +220,7 @@ end Grid;
   expectScalarFallback(grid("parameter Real w[n] = {1 + i for i in 1:n};", "w[i]"));
   expectScalarFallback(grid("parameter Real w[n + 1, m] = {{i + 2*j for j in 1:m} for i in 1:n + 1};", "w[i, j]"));
   expectScalarFallback(grid("parameter Real w[n, m] = {{i + 2*j for j in 1:m} for i in 1:n};", "w[2, j]"));
+  expectScalarFallback(grid("constant Real w[4, 4] = {{i + 2*j for j in 1:4} for i in 1:4};", "w[i, j]"));
 }
 
 TEST(LoopedKernels, PendulumWithoutRepeatedStructureHasNoLoops) {

@@ -1,8 +1,8 @@
 // Loops in bytecode written by hand: the VM runs affine and table loops (peeled stencil ends,
 // count 0 and 1, invariant registers, stx through a permutation, ldidx, negative offsets, a
-// parameter array read with ldpl) exactly
-// as the direct C++ computation; modules with loops survive serialisation; the validator rejects
-// every broken loop rule; a non-finite value inside a loop is named with its iteration and offset.
+// parameter array read with ldpl) exactly as the direct C++ computation; modules with loops
+// survive serialisation; the validator rejects every broken loop rule (an ldpl outside the
+// parameters too); a non-finite value inside a loop is named with its iteration and offset.
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -310,6 +310,19 @@ TEST(VmLoops, ALoopedParameterLoadReadsItsArrayElement) {
   EXPECT_EQ(q->residual(q, 0, y.data(), yp.data(), p.data(), F.data()), 0);
   for (uint32_t i = 0; i + 1 < n; ++i) EXPECT_EQ(std::bit_cast<uint64_t>(F[i]), std::bit_cast<uint64_t>(p[i + 1] * y[i])) << i;
   EXPECT_EQ(F[n - 1], 0.0);
+}
+
+TEST(VmLoops, ANonFiniteParameterReadInALoopIsNamed) {
+  const uint32_t n = 6;
+  Result<ModelPtr> model = vm::createModel(parameterLoop(n));
+  ASSERT_TRUE(model.ok()) << model.error();
+  QdotModel* q = model.value().get();
+  std::vector<double> y = randomY(n), yp(n, 0.0), p(n, 1.0), F(n);
+  p[3] = std::nan("");  // read by iteration c = 2 (a[1 + L], L = 2)
+  EXPECT_EQ(q->residual(q, 0, y.data(), yp.data(), p.data(), F.data()), 1);
+  std::string e = q->lastError(q);
+  EXPECT_NE(e.find("parameter a3 is nan"), std::string::npos) << e;
+  EXPECT_NE(e.find("loop iteration 2, offset 2"), std::string::npos) << e;
 }
 
 TEST(VmLoopValidation, RejectsALoopedParameterLoadOutsideTheParameters) {
