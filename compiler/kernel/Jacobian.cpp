@@ -143,7 +143,9 @@ ElementBase unknownsRead(const dae::TemplateBlock& block, const flat::RelativeEl
 // The parameter index of the first element of an array whose element k is parameter first + k
 // (ldpl reads p[first + linear index]), or -1. `parameterOf`: by symbol id, the parameter or -1.
 int parameterBase(const flat::ArrayVariable& a, const std::vector<int>& parameterOf) {
-  auto of = [&](sym::Expr e) { return e->isSymbol() && e->symbolId < parameterOf.size() ? parameterOf[e->symbolId] : -1; };
+  auto of = [&](sym::Expr e) {
+    return e->isSymbol() && e->symbolId < parameterOf.size() ? parameterOf[e->symbolId] : -1;
+  };
   int first = a.elements.empty() ? -1 : of(a.elements[0]);
   for (size_t k = 1; first >= 0 && k < a.elements.size(); ++k)
     if (of(a.elements[k]) != first + static_cast<int>(k)) return -1;

@@ -33,7 +33,8 @@ std::string operands(const Instr& ins, const Program& prog, const KernelModule& 
     case bc::Format::None: return "";
     case bc::Format::Index: {
       if (ins.op == Op::LoadConst) return shortestText(prog.constants[ins.imm]);
-      if (ins.op == Op::LoadYLooped || ins.op == Op::LoadYpLooped || ins.op == Op::LoadPLooped) return std::to_string(ins.imm) + " + L";
+      if (ins.op == Op::LoadYLooped || ins.op == Op::LoadYpLooped || ins.op == Op::LoadPLooped)
+        return std::to_string(ins.imm) + " + L";
       const auto* names = namesOfLoad(ins.op, m);
       return std::to_string(ins.imm) + (names && ins.imm < names->size() ? std::string(" (").append((*names)[ins.imm]) + ")" : "");
     }

@@ -60,8 +60,8 @@ Status validate(const kernel::KernelModule& k) {
     if (k.programs[i].outputCount != expected)
       return Error{"kernel program " + k.programs[i].name + " writes " + std::to_string(k.programs[i].outputCount) +
                    " values, the model ABI expects " + std::to_string(expected)};
-    if (std::string e = kernel::checkLoops(k.programs[i], k.variableCount(), k.description.parameterCount()); !e.empty())
-      return Error{"kernel program " + k.programs[i].name + ": " + e};
+    std::string e = kernel::checkLoops(k.programs[i], k.variableCount(), k.description.parameterCount());
+    if (!e.empty()) return Error{"kernel program " + k.programs[i].name + ": " + e};
   }
   if (std::string e = k.description.inconsistency(); !e.empty()) return Error{"kernel module: " + e};
   return {};

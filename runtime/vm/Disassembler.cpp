@@ -19,7 +19,8 @@ std::string indexName(const bc::Module& m, bc::Opcode op, uint32_t i, const bc::
   if (op == bc::Opcode::LoadP || op == bc::Opcode::LoadGiven || op == bc::Opcode::LoadOverridden)
     names = &m.description.parameterNames;
   if (op == bc::Opcode::LoadConst && i < f.constants.size()) return std::to_string(i) + std::string(" (").append(shortestText(f.constants[i])) + ")";
-  if (op == bc::Opcode::LoadYLooped || op == bc::Opcode::LoadYpLooped || op == bc::Opcode::LoadPLooped) return std::to_string(i) + " + L";
+  if (op == bc::Opcode::LoadYLooped || op == bc::Opcode::LoadYpLooped || op == bc::Opcode::LoadPLooped)
+    return std::to_string(i) + " + L";
   return std::to_string(i) + (names && i < names->size() ? std::string(" (").append((*names)[i]) + ")" : "");
 }
 

@@ -173,15 +173,16 @@ TEST(ForEquations, RodWithVaryingConductanceReadsItInTheLoop) {
   EXPECT_EQ(expectSameKernels(kVaryingRod, 1), 1u);
   EXPECT_EQ(expectSameKernels(kVaryingRod, 1, {{"a0", 0.3}, {"a[4]", 5.0}}), 1u);
   Compiled looped(kVaryingRod, true);
-  EXPECT_EQ(test::opCount(looped.kernels().program(ModelProgram::Residual), kernel::Op::LoadPLooped), 2u);  // a[%1], a[%1-1]
-  EXPECT_EQ(test::opCount(looped.kernels().program(ModelProgram::Jacobian), kernel::Op::LoadPLooped), 2u);
+  const kernel::KernelModule& k = looped.kernels();
+  EXPECT_EQ(test::opCount(k.program(ModelProgram::Residual), kernel::Op::LoadPLooped), 2u);  // a[%1], a[%1-1]
+  EXPECT_EQ(test::opCount(k.program(ModelProgram::Jacobian), kernel::Op::LoadPLooped), 2u);
 }
 
 TEST(ForEquations, PlateWithATwoDimensionalParameterArrayReadsItInTheLoop) {
   std::string text = plate(R"(  for i in 2:n-1, j in 2:m-1 loop
     der(T[i, j]) = kap[i, j]*(T[i+1, j] + T[i-1, j] + T[i, j+1] + T[i, j-1] - 4*T[i, j]) - kap[i+1, j-1]*T[i, j]^2;
   end for;)");
-  text.replace(text.find("  Real T[n, m]"), 0, "  parameter Real kap[n, m] = {{a + 0.1*i*j for j in 1:m} for i in 1:n};\n");
+  text.insert(text.find("  Real T[n, m]"), "  parameter Real kap[n, m] = {{a + 0.1*i*j for j in 1:m} for i in 1:n};\n");
   EXPECT_EQ(expectSameKernels(text, 1), 1u);
   EXPECT_EQ(expectSameKernels(text, 1, {{"a", 2.0}, {"kap[3,3]", -1.0}}), 1u);
   Compiled looped(text, true);
@@ -204,8 +205,10 @@ void expectScalarFallback(const std::string& text) {
 // keeps the model scalar.
 TEST(ForEquations, ParameterArraysALoopCannotAddressKeepTheModelScalar) {
   for (const char* read : {"kap[i, j]", "kap[j, i]"}) {
-    std::string text = plate("  for i in 2:n-1, j in 2:m-1 loop\n    der(T[i, j]) = " + std::string(read) + "*T[i+1, j];\n  end for;");
-    text.replace(text.find("  Real T[n, m]"), 0, "  parameter Real kap[n + 1, n + 1] = {{i - j for j in 1:n + 1} for i in 1:n + 1};\n");
+    std::string text =
+        plate("  for i in 2:n-1, j in 2:m-1 loop\n    der(T[i, j]) = " + std::string(read) + "*T[i+1, j];\n  end for;");
+    text.insert(text.find("  Real T[n, m]"),
+                "  parameter Real kap[n + 1, n + 1] = {{i - j for j in 1:n + 1} for i in 1:n + 1};\n");
     expectScalarFallback(text);
   }
 }

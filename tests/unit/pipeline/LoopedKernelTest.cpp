@@ -167,7 +167,8 @@ end Bound;
   EXPECT_GE(expectSameKernels(text, {{"m0", 3.5}, {"k[4]", 7.0}, {"m[2]", 0.25}}), 2u);
   // The given values change the residual: the comparison above is not of two unchanged kernels.
   Compiled looped(text, true);
-  test::KernelValues plain = test::evaluateAt(looped.kernels(), 0), given = test::evaluateAt(looped.kernels(), 0, {{"k[4]", 7.0}});
+  test::KernelValues plain = test::evaluateAt(looped.kernels(), 0);
+  test::KernelValues given = test::evaluateAt(looped.kernels(), 0, {{"k[4]", 7.0}});
   EXPECT_NE(plain.F, given.F);
 }
 

@@ -308,7 +308,8 @@ TEST(VmLoops, ALoopedParameterLoadReadsItsArrayElement) {
   std::vector<double> y = randomY(n), yp(n, 0.0), p(n), F(n, -99.0);
   for (uint32_t i = 0; i < n; ++i) p[i] = 0.5 + i * i;
   EXPECT_EQ(q->residual(q, 0, y.data(), yp.data(), p.data(), F.data()), 0);
-  for (uint32_t i = 0; i + 1 < n; ++i) EXPECT_EQ(std::bit_cast<uint64_t>(F[i]), std::bit_cast<uint64_t>(p[i + 1] * y[i])) << i;
+  for (uint32_t i = 0; i + 1 < n; ++i)
+    EXPECT_EQ(std::bit_cast<uint64_t>(F[i]), std::bit_cast<uint64_t>(p[i + 1] * y[i])) << i;
   EXPECT_EQ(F[n - 1], 0.0);
 }
 
@@ -327,7 +328,8 @@ TEST(VmLoops, ANonFiniteParameterReadInALoopIsNamed) {
 
 TEST(VmLoopValidation, RejectsALoopedParameterLoadOutsideTheParameters) {
   bc::Module m = parameterLoop(5);
-  m.function(ModelProgram::Residual).code[wordOf(m.function(ModelProgram::Residual), Opcode::LoadPLooped) + 2] = 2;  // a[2 + 3]
+  bc::Function& residual = m.function(ModelProgram::Residual);
+  residual.code[wordOf(residual, Opcode::LoadPLooped) + 2] = 2;  // a[2 + L] reaches a[5] at L = 3
   Status s = bc::validate(m);
   ASSERT_FALSE(s);
   EXPECT_NE(s.error().find("ldpl index out of range"), std::string::npos) << s.error();
