@@ -56,13 +56,17 @@ def measure(build, n, stop):
     stages["codegen"] = number(r"codegen \([^)]*\) ([0-9.e+-]+)", err) / 1e3
     setup = number(r"setup ([0-9.e+-]+) s", err)
     solve = number(r"solve ([0-9.e+-]+) s", err)
+    step1 = number(r"first step ([0-9.e+-]+) s", err)
     hand = [f"{build}/bench/reference_sim", "chain", "--n", str(n), "--stop", str(stop), "--interval", str(stop),
             "--outputs", "x[1]", "-o", "/dev/null", "--stats"]
     hwall, hpeak, herr = peak_of(hand)
     hsetup = number(r"setup ([0-9.e+-]+) s", herr)
-    return {"n": n, "wall": wall, "peak": peak, "setup": setup, "solve": solve, **stages,
-            "first": wall - solve, "hwall": hwall, "hpeak": hpeak, "hfirst": hwall - number(r"solve ([0-9.e+-]+) s", herr),
-            "hsetup": hsetup}
+    hstep1 = number(r"first step ([0-9.e+-]+) s", herr)
+    # file -> first step: the whole process but the solve after IDA's first completed step (its
+    # first matrix factorization, KLU's analysis included, belongs to the way there).
+    return {"n": n, "wall": wall, "peak": peak, "setup": setup, "solve": solve, "step1": step1, **stages,
+            "first": wall - solve + step1, "hwall": hwall, "hpeak": hpeak,
+            "hfirst": hwall - number(r"solve ([0-9.e+-]+) s", herr) + hstep1, "hsetup": hsetup, "hstep1": hstep1}
 
 
 def whole(build, n, stop, repeat):
@@ -95,11 +99,12 @@ def small_models(build, repeat):
         for _ in range(repeat):
             wall, _, err = peak_of(command)
             best_wall = min(best_wall, wall)
-            inside = number(r"; total ([0-9.e+-]+)", err) / 1e3 + number(r"setup ([0-9.e+-]+) s", err)
+            inside = (number(r"; total ([0-9.e+-]+)", err) / 1e3 + number(r"setup ([0-9.e+-]+) s", err) +
+                      number(r"first step ([0-9.e+-]+) s", err))
             best_inside = min(best_inside, inside)
         rows.append((name, best_wall, best_inside))
     print(f"\n## Small models: file to first step on the VM (best of {repeat} processes)\n")
-    print("| model | **file → first step**: compile + IDA setup (--stats) [ms] | whole process to t = 1e-4 s, with the process start [ms] |")
+    print("| model | **file → first step**: compile + IDA setup + first step (--stats) [ms] | whole process to t = 1e-4 s, with the process start [ms] |")
     print("| --- | ---: | ---: |")
     for name, wall, inside in rows:
         print(f"| {name} | {inside * 1e3:.2f} | {wall * 1e3:.1f} |")
@@ -135,11 +140,14 @@ def main():
                                                                    [1000, 10000, 100000, 1000000])
     rows = [measure(a.build, n, a.stop) for n in sizes]
     print("\n## Scaling: the spring chain from the file to the first steps (bench/scaling_bench.py)\n")
-    print(f"Horizon {a.stop:g} s (IDACalcIC and the first steps), rtol 1e-6, KLU; qdot with --jit-wait "
-          "(every stage, then native code). Times in seconds, memory = peak RSS.\n")
-    cols = ["flatten", "derive", "dae", "kernel", "codegen", "setup", "first", "peak", "hsetup", "hfirst", "hpeak"]
-    head = ["n", "flatten", "derive", "dae", "kernel", "codegen+JIT", "IDA setup", "**file → first step**",
-            "peak [MiB]", "hand setup", "**hand: start → first step**", "hand peak [MiB]", "time ratio", "memory ratio"]
+    print(f"Horizon {a.stop:g} s, rtol 1e-6, KLU; qdot with --jit-wait (every stage, then native code). "
+          "File → first step: the process from its start to IDA's first completed step (IDA setup, then "
+          "the first step with its matrix factorization). Times in seconds, memory = peak RSS.\n")
+    cols = ["flatten", "derive", "dae", "kernel", "codegen", "setup", "step1", "first", "peak", "hsetup", "hstep1",
+            "hfirst", "hpeak"]
+    head = ["n", "flatten", "derive", "dae", "kernel", "codegen+JIT", "IDA setup", "first step", "**file → first step**",
+            "peak [MiB]", "hand setup", "hand first step", "**hand: start → first step**", "hand peak [MiB]",
+            "time ratio", "memory ratio"]
     print("| " + " | ".join(head) + " |")
     print("|" + "---:|" * len(head))
     for r in rows:

@@ -37,11 +37,13 @@ struct RunResult {
   double lastStep = 0;
   int lastOrder = 0;
   bool computedInitialValues = false;
+  bool diagonalRates = false;  ///< y' made consistent by one division (else IDACalcIC), if computed
   bool sparse = false;
   std::size_t rows = 0;
   rt::ToleranceSummary tolerances;
   double setupSeconds = 0;  ///< IDA set up, consistent start
   double solveSeconds = 0;  ///< IDASolve over the output grid, and writing the rows
+  double firstStepSeconds = 0;  ///< from the start of the solve to IDA's first completed step
 };
 
 /// The output times: start + k·interval while below stop (closer than 1e-9 intervals counts as

@@ -2,6 +2,9 @@
 // that it is one, and its unknowns and rows, row j defining the derivative of unknown j.
 #include "dae/TemplateOde.h"
 
+#include <algorithm>
+#include <initializer_list>
+
 #include "flatten/Flatten.h"
 #include "support/Assert.h"
 
@@ -50,37 +53,68 @@ bool onlyEquations(const flat::FlatModel& m) {
          m.forces.empty() && m.constraints.empty() && m.initialEquations.empty() && m.components.size() <= 1;
 }
 
+// The derivative symbols of a row (scalar variables or relative symbols of arrays of derivatives)
+// and the other symbols it reads.
+struct RowSymbols {
+  std::vector<Expr> rates, others;
+};
+
+RowSymbols rowSymbols(const flat::FlatModel& m, const sym::Context& ctx, std::initializer_list<Expr> sides) {
+  RowSymbols r;
+  std::vector<Expr> symbols;
+  for (Expr side : sides)
+    for (Expr s : ctx.freeSymbols(side))
+      if (std::find(symbols.begin(), symbols.end(), s) == symbols.end()) symbols.push_back(s);
+  for (Expr s : symbols) {
+    const flat::RelativeElement* rel = m.relativeElement(s);
+    Expr element = rel ? m.patterns->arrays[rel->array].elements[0] : s;
+    int v = m.variableOf(element);
+    (v >= 0 && m.variables[v].role == VarRole::Derivative ? r.rates : r.others).push_back(s);
+  }
+  return r;
+}
+
+// The relative symbol of the one derivative a template row names, `der(x)[%1,…]` with the
+// iterators in order and no offset, or null.
+const flat::RelativeElement* ownRate(const flat::FlatModel& m, const std::vector<Expr>& rates, size_t iterators) {
+  const flat::RelativeElement* own = rates.size() == 1 ? m.relativeElement(rates[0]) : nullptr;
+  if (!own || !indexedInOrder(*own, iterators)) return nullptr;
+  for (const auto& dim : own->dims)
+    if (dim.offset != 0) return nullptr;
+  return own;
+}
+
 class OdeCheck {
  public:
   OdeCheck(const flat::FlatModel& m, const sym::Context& ctx) : m_(m), ctx_(ctx), firstUnknown_(m.patterns->arrays.size(), -2) {}
 
-  // The unknown a scalar row `der(x) = rhs` defines (rhs over unknowns, parameters and time), or -1.
+  // The unknown whose derivative a scalar row names, its only one (`der(x) = rhs`, `m*der(v) = f`,
+  // over unknowns, parameters and time), or -1.
   int scalarRow(const flat::Equation& e) const {
-    if (!e.lhs || !e.rhs) return -1;
-    for (Expr s : ctx_.freeSymbols(e.rhs))
-      if (int v = m_.variableOf(s); v < 0 || m_.variables[v].role == VarRole::Derivative) return -1;
-    return unknownOfRate(m_, e.lhs);
+    RowSymbols s = rowSymbols(m_, ctx_, {e.residual});
+    for (Expr other : s.others)
+      if (m_.variableOf(other) < 0) return -1;
+    return s.rates.size() == 1 ? unknownOfRate(m_, s.rates[0]) : -1;
   }
 
-  // The unknown of the first element of the array whose derivatives a template `der(x)[%1,…] = rhs`
-  // defines, or -1. The right side reads arrays of unknowns and of parameters (ldpl) by the
-  // template's iterators in order.
+  // The unknown of the first element of the array whose derivatives a template row names, its only
+  // derivative `der(x)[%1,…]` (`der(x)[%1] = rhs`, `m*der(v)[%1] = f`), or -1. The row reads arrays
+  // of unknowns and of parameters (ldpl) by the template's iterators in order.
   int templateRow(const flat::EquationTemplate& t) {
-    const flat::RelativeElement* own = m_.relativeElement(t.lhs);
-    if (!own || !indexedInOrder(*own, t.box.size())) return -1;
-    for (const auto& dim : own->dims)
-      if (dim.offset != 0) return -1;
+    RowSymbols s = rowSymbols(m_, ctx_, {t.lhs, t.rhs});
+    const flat::RelativeElement* own = ownRate(m_, s.rates, t.box.size());
+    if (!own) return -1;
     const flat::ArrayVariable& rates = m_.patterns->arrays[own->array];
     int first = firstOfConsecutive(rates, [&](Expr e) { return unknownOfRate(m_, e); });
-    for (Expr s : ctx_.freeSymbols(t.rhs)) {
-      if (const flat::RelativeElement* rel = m_.relativeElement(s)) {
+    for (Expr other : s.others) {
+      if (const flat::RelativeElement* rel = m_.relativeElement(other)) {
         if (flat::loopableParameters(m_, *rel, t.box.size(), rates.shape)) continue;
         const flat::ArrayVariable& a = m_.patterns->arrays[rel->array];
         bool shaped = t.box.size() == 1 || a.shape == rates.shape;
         if (!indexedInOrder(*rel, t.box.size()) || !shaped || firstUnknown(rel->array) < 0) return -1;
         continue;
       }
-      int v = m_.variableOf(s);
+      int v = m_.variableOf(other);
       if (v < 0 || (m_.variables[v].role != VarRole::Parameter && m_.variables[v].role != VarRole::Time)) return -1;
     }
     return first;
@@ -102,8 +136,9 @@ class OdeCheck {
   }
 };
 
-const flat::ArrayVariable& definedArray(const flat::FlatModel& m, const flat::EquationTemplate& t) {
-  return m.patterns->arrays[m.relativeElement(t.lhs)->array];
+// The array whose derivatives a template (of a templated ODE) defines.
+const flat::ArrayVariable& definedArray(const flat::FlatModel& m, const sym::Context& ctx, const flat::EquationTemplate& t) {
+  return m.patterns->arrays[ownRate(m, rowSymbols(m, ctx, {t.lhs, t.rhs}).rates, t.box.size())->array];
 }
 
 }  // namespace
@@ -120,7 +155,7 @@ bool isTemplatedOde(const flat::FlatModel& m, const sym::Context& ctx) {
   for (const flat::EquationTemplate& t : m.equationTemplates) {
     int first = check.templateRow(t);
     if (first < 0) return false;
-    const std::vector<int>& shape = definedArray(m, t).shape;
+    const std::vector<int>& shape = definedArray(m, ctx, t).shape;
     flat::forEachPoint(t.box, [&](std::span<const long> p, size_t) { ++rows[first + flat::linearIndex(shape, p)]; });
   }
   for (size_t i = 0; i < m.variables.size(); ++i)
@@ -143,13 +178,14 @@ void addTemplatedOde(const flat::FlatModel& m, sym::Context& ctx, Dae& dae) {
     QDOT_ASSERT(row >= 0 && !placed[row], "a row of a templated ODE defined twice");
     placed[row] = 1;
   };
+  OdeCheck check(m, ctx);
   for (const flat::Equation& e : m.equations) {
-    int row = unknown[unknownOfRate(m, e.lhs)];
+    int row = unknown[check.scalarRow(e)];
     place(row);
     dae.equations[row] = e;
   }
   for (const flat::EquationTemplate& t : m.equationTemplates) {
-    const flat::ArrayVariable& rates = definedArray(m, t);
+    const flat::ArrayVariable& rates = definedArray(m, ctx, t);
     int first = unknown[unknownOfRate(m, rates.elements[0])];
     dae.templateBlocks.push_back({first, rates.shape, t.box, ctx.sub(t.lhs, t.rhs), flat::OriginKind::Equation, t.origin.range});
     flat::forEachPoint(t.box, [&](std::span<const long> p, size_t) {

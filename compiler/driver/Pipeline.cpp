@@ -111,20 +111,11 @@ void returnFreedMemory() {
 #endif
 }
 
-// `der(x[i, …]) = …`, the form of the equations a `for` loop may keep as one template.
-bool isOwnDerivativeEquation(const ast::Equation& eq) {
-  if (eq.kind == ast::EquationKind::For) {
-    auto own = [](const ast::Equation& e) { return isOwnDerivativeEquation(e); };
-    return !eq.body.empty() && std::all_of(eq.body.begin(), eq.body.end(), own);
-  }
-  auto* call = eq.kind == ast::EquationKind::Simple && eq.lhs ? ast::dyn_cast<ast::CallExpr>(eq.lhs.get()) : nullptr;
-  return call && call->callee->dotted() == "der" && call->args.size() == 1 && ast::dyn_cast<ast::IndexExpr>(call->args[0].get());
-}
-
 // Whether `for` equations may stay templates (docs/loops.md), from the syntax: a run that keeps
 // loops and needs no invariants, of a model of equations only — no mechanics, initial equations or
-// components — with a `for` loop of `der(x[i]) = …` equations. Flattening then keeps them only if
-// the model is an explicit ODE (dae::isTemplatedOde), else it flattens again.
+// components — with a `for` loop of equations naming one derivative each (`der(x[i]) = …`,
+// `m*der(v[i]) = …`, flat::mayKeepForEquation). Flattening then keeps them only if the model is an
+// ODE with one derivative per row (dae::isTemplatedOde), else it flattens again.
 bool forEquationsMayStay(const Compilation& c) {
   const sema::CheckedClass& root = *c.checked->root;
   if (!c.options.keepLoops || c.options.keepInvariants || !root.mechanics.empty() || !root.initialEquations.empty())
@@ -132,7 +123,7 @@ bool forEquationsMayStay(const Compilation& c) {
   for (const auto& [name, symbol] : root.symbols)
     if (symbol.kind == sema::SymbolKind::Component) return false;
   return std::any_of(root.equations.begin(), root.equations.end(), [](const ast::Equation* eq) {
-    return eq->kind == ast::EquationKind::For && isOwnDerivativeEquation(*eq);
+    return eq->kind == ast::EquationKind::For && flat::mayKeepForEquation(*eq);
   });
 }
 

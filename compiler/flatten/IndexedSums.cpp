@@ -4,8 +4,8 @@
 // each such subscript a *relative symbol* (`x[%1+1]`), instead of once per element. Anything else
 // is lowered as before, so a template is only ever an exact rewriting of what expansion gives
 // (expandIndexedSums turns it back; tests/unit/IndexedSumTest.cpp checks node identity).
-// With FlattenLimits::keepForEquations, a top-level `for` equation `der(x[i]) = rhs` is lowered
-// the same way, once (EquationTemplate).
+// With FlattenLimits::keepForEquations, a top-level `for` equation naming one derivative,
+// `der(x[i]) = rhs` or `m*der(v[i]) = f`, is lowered the same way, once (EquationTemplate).
 #include <algorithm>
 #include <cmath>
 
@@ -241,7 +241,48 @@ bool isOwnDerivative(const ast::Expr& e, const TemplateCheck& check, size_t iter
   return true;
 }
 
+// Collects the der() calls of an expression; false if it has a part no template can hold (the
+// precise check is TemplateCheck's).
+bool collectDerCalls(const ast::Expr& e, std::vector<const CallExpr*>& calls) {
+  switch (e.kind) {
+    case ExprKind::Number:
+    case ExprKind::Name: return true;
+    case ExprKind::Unary: return collectDerCalls(*cast<UnaryExpr>(&e)->operand, calls);
+    case ExprKind::Binary:
+      return collectDerCalls(*cast<BinaryExpr>(&e)->lhs, calls) && collectDerCalls(*cast<BinaryExpr>(&e)->rhs, calls);
+    case ExprKind::Index: {
+      auto* x = cast<IndexExpr>(&e);
+      for (const auto& s : x->subscripts)
+        if (!collectDerCalls(*s, calls)) return false;
+      return collectDerCalls(*x->base, calls);
+    }
+    case ExprKind::Call: {
+      auto* c = cast<CallExpr>(&e);
+      if (c->callee->dotted() == "der") calls.push_back(c);
+      for (const auto& a : c->args)
+        if (!collectDerCalls(*a, calls)) return false;
+      return c->namedArgs.empty();
+    }
+    default: return false;
+  }
+}
+
+// The one der() call of an equation, or null.
+const CallExpr* onlyDerCall(const ast::Equation& eq) {
+  if (eq.kind != EquationKind::Simple || !eq.lhs || !eq.rhs) return nullptr;
+  std::vector<const CallExpr*> calls;
+  if (!collectDerCalls(*eq.lhs, calls) || !collectDerCalls(*eq.rhs, calls) || calls.size() != 1) return nullptr;
+  return calls[0];
+}
+
 }  // namespace
+
+bool mayKeepForEquation(const ast::Equation& loop) {
+  if (loop.kind == EquationKind::For)
+    return !loop.body.empty() && std::all_of(loop.body.begin(), loop.body.end(), mayKeepForEquation);
+  const CallExpr* der = onlyDerCall(loop);
+  return der && der->args.size() == 1 && dyn_cast<IndexExpr>(der->args[0].get());
+}
 
 // The iterators of a top-level `for` equation and of the loops nested in it while each loop holds
 // only the next (`for i … loop for j … loop … end for; end for`); `innermost` becomes the loop whose
@@ -257,8 +298,9 @@ std::optional<std::vector<TemplateIterator>> Flattener::equationTemplateIterator
 }
 
 // Every equation of the loop as a template, or false (nothing recorded) where the scalar lowering
-// must do the loop: an equation of another form than `der(x[i, …]) = rhs`, a body TemplateCheck
-// refuses, a subscript out of bounds.
+// must do the loop: an equation that names no derivative or more than one, or one of another
+// element than `der(x[i, …])` (the iterators in order), a side TemplateCheck refuses, a subscript
+// out of bounds.
 bool Flattener::lowerEquationTemplates(const ast::Equation& loop) {
   const ast::Equation* innermost = &loop;
   std::optional<std::vector<TemplateIterator>> its = equationTemplateIterators(innermost);
@@ -277,8 +319,9 @@ bool Flattener::lowerEquationTemplates(const ast::Equation& loop) {
 std::optional<EquationTemplate> Flattener::lowerEquationTemplate(const ast::Equation& eq,
                                                                  const std::vector<TemplateIterator>& its) {
   TemplateCheck check(its);
-  if (eq.kind != EquationKind::Simple || !eq.lhs || !eq.rhs) return std::nullopt;
-  if (!isOwnDerivative(*eq.lhs, check, its.size()) || !check.body(*eq.rhs)) return std::nullopt;
+  const CallExpr* der = onlyDerCall(eq);
+  if (!der || !isOwnDerivative(*der, check, its.size()) || !check.body(*eq.lhs) || !check.body(*eq.rhs))
+    return std::nullopt;
   EquationTemplate t;
   templateIterators_ = its;
   ratesOfUnknowns_ = true;

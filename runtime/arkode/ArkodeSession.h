@@ -49,6 +49,7 @@ class ArkodeSession {
   std::span<const double> absoluteTolerances() const;
   LinearSolverKind linearSolver() const;  ///< Dense or Klu
   bool computedInitialValues() const { return false; }
+  InitialValueMethod initialValueMethod() const { return InitialValueMethod::AsGiven; }
   const std::vector<std::string>& warnings() const;
 
  private:

@@ -19,6 +19,7 @@
 #include <cmath>
 
 #include "arkode/StartLinearization.h"
+#include "ida/DiagonalRates.h"
 #include "ida/DummyDerivatives.h"
 #include "ida/IdaFlags.h"
 #include "ida/InitialSystem.h"
@@ -73,6 +74,7 @@ constexpr double kCalcICShrink = 1e-3;
 /// |F_i| at or below this counts as zero when deciding whether IDACalcIC is needed.
 constexpr double kConsistentResidual = 1e-14;
 
+
 }  // namespace
 
 struct IdaSession::Impl {
@@ -101,7 +103,8 @@ struct IdaSession::Impl {
   TimeScale timeScale;  ///< the velocities' time scale, from the linearization at the start
   double t;
   double tout = 0;
-  bool calcIC = false;
+  InitialValueMethod initialValues = InitialValueMethod::AsGiven;
+  std::optional<std::chrono::steady_clock::time_point> firstStepDone;
 
   // What the last failure was, for the checking helper's message.
   bool modelFailed = false;
@@ -126,8 +129,14 @@ struct IdaSession::Impl {
   void applyTolerances(bool calibrated = true);
   void initialize(double tout1);
   void calculateConsistentValues(double tout1);
+  void restartFromConsistentValues();
   void estimateAlgebraicRates(double tout1);
-  void checkStartMatrix();
+  /// ∂F/∂y and J(cj = 1) at the start, in the Jacobian's CSC order (empty if J cannot be evaluated).
+  struct StartJacobians {
+    std::vector<double> at0, at1;
+  };
+  StartJacobians checkStartMatrix();
+  bool solveDiagonalRates(const StartJacobians& start, std::vector<double> F, double tout1);
   std::vector<std::string> dependentColumns(const std::vector<double>& at0, const std::vector<double>& at1) const;
   bool chooseDummyDerivatives(double time, N_Vector yv, N_Vector ypv, bool best);
   void solveInitialConditions();
@@ -136,7 +145,7 @@ struct IdaSession::Impl {
   const QdotModel& fullModel() const { return dummies ? *reinterpret_cast<const SquareTable*>(&model)->full : model; }
   void useChoice(double time, N_Vector yv, N_Vector ypv);
   double stepTo(double target);
-  bool startIsConsistent();
+  std::vector<double> startResidual();
   void noteChangedFixedStarts(const std::vector<double>& before);
   double advanceTo(double target);
   SolverStats stats();
@@ -247,7 +256,12 @@ int IdaSession::Impl::evaluateResidual(double time, const double* yv, const doub
 }
 
 int IdaSession::Impl::residualCallback(sunrealtype time, N_Vector yv, N_Vector ypv, N_Vector F, void* self) {
-  return static_cast<Impl*>(self)->evaluateResidual(time, data(yv), data(ypv), data(F));
+  auto* impl = static_cast<Impl*>(self);
+  if (!impl->firstStepDone) {
+    long steps = 0;
+    if (IDAGetNumSteps(impl->ida, &steps) == IDA_SUCCESS && steps > 0) impl->firstStepDone = std::chrono::steady_clock::now();
+  }
+  return impl->evaluateResidual(time, data(yv), data(ypv), data(F));
 }
 
 void IdaSession::Impl::scatterDense(SUNMatrix J) {
@@ -385,12 +399,42 @@ void IdaSession::Impl::attachLinearSolver() {
 
 // --- consistent initial values --------------------------------------------------------------
 
-bool IdaSession::Impl::startIsConsistent() {
+std::vector<double> IdaSession::Impl::startResidual() {
   std::vector<double> F(n);
   clearFailure();
   if (evaluateResidual(options.t0, data(y), data(yp), F.data()) != 0)
     failOutsideIda("the residual cannot be evaluated at the start", options.t0);
+  return F;
+}
+
+namespace {
+
+bool consistent(const std::vector<double>& F) {
   return std::all_of(F.begin(), F.end(), [](double f) { return std::abs(f) <= kConsistentResidual; });
+}
+
+}  // namespace
+
+// Every unknown differential and ∂F/∂y' diagonal up to the order of its rows (ida/DiagonalRates.h):
+// y' from one division per unknown instead of IDACalcIC, whose matrix (∂F/∂y + ∂F/∂y'/h) needs a
+// factorization and usually more than one iteration — at 10⁶ unknowns a large part of the time to
+// the first step. Accepted by IDACalcIC's own convergence test; otherwise (F not linear in y') the
+// start values are restored and IDACalcIC runs as before.
+bool IdaSession::Impl::solveDiagonalRates(const StartJacobians& start, std::vector<double> F, double tout1) {
+  if (start.at0.empty()) return false;
+  std::optional<DiagonalRates> rates =
+      diagonalRates<int32_t>({model.jacobianColumnStarts, n + 1}, {model.jacobianRowIndices, start.at0.size()},
+                             start.at0, start.at1);
+  if (!rates) return false;
+  std::vector<double> given(data(yp), data(yp) + n);
+  stepRates(*rates, F, {data(yp), n});
+  clearFailure();
+  if (evaluateResidual(options.t0, data(y), data(yp), F.data()) == 0 &&
+      ratesConverged(*rates, F, {data(y), n}, tolerances.solverRtol, tolerances.atol, tout1 - options.t0))
+    return true;
+  std::copy(given.begin(), given.end(), data(yp));
+  clearFailure();
+  return false;
 }
 
 // Consistent initialization changes only algebraic unknowns. One whose start was fixed — by default
@@ -510,12 +554,12 @@ std::vector<std::string> IdaSession::Impl::dependentColumns(const std::vector<do
   return dependent;
 }
 
-void IdaSession::Impl::checkStartMatrix() {
+IdaSession::Impl::StartJacobians IdaSession::Impl::checkStartMatrix() {
   uint32_t nnz = model.jacobianNonzeros;
   std::vector<double> at0(nnz), at1(nnz);
   if (model.jacobian(&model, options.t0, data(y), data(yp), p.data(), 0.0, at0.data()) != 0 ||
       model.jacobian(&model, options.t0, data(y), data(yp), p.data(), 1.0, at1.data()) != 0)
-    return;  // a failing Jacobian is reported where IDA meets it, with its message
+    return {};  // a failing Jacobian is reported where IDA meets it, with its message
   auto names = nameList(model.variableNames, n);
   std::vector<std::string> missing;
   // dF/dy' is J(cj = 1) - J(cj = 0): where |dF/dy| is so large that adding 1 does not change it
@@ -530,7 +574,7 @@ void IdaSession::Impl::checkStartMatrix() {
   }
   bool dependent = missing.empty() && dummies;
   if (dependent) missing = dependentColumns(at0, at1);
-  if (missing.empty()) return;
+  if (missing.empty()) return {std::move(at0), std::move(at1)};
   std::string list;
   for (size_t i = 0; i < missing.size() && i < 8; ++i) list += (i ? ", " : "") + missing[i];
   if (missing.size() > 8) list += fmt::format(", … ({} more)", missing.size() - 8);
@@ -546,9 +590,17 @@ void IdaSession::Impl::checkStartMatrix() {
 void IdaSession::Impl::initialize(double tout1) {
   if (n == 0) return;
   if (fullModel().nInitialRows > 0) solveInitialConditions();
-  checkStartMatrix();
+  StartJacobians start = checkStartMatrix();
   bool hasAlgebraic = std::any_of(model.isDifferential, model.isDifferential + n, [](int32_t d) { return d == 0; });
-  if (!hasAlgebraic && startIsConsistent()) return applyTolerances();
+  if (!hasAlgebraic) {
+    std::vector<double> F = startResidual();
+    if (consistent(F)) return applyTolerances();
+    if (!dummies && solveDiagonalRates(start, std::move(F), tout1)) {
+      initialValues = InitialValueMethod::DiagonalRates;
+      return restartFromConsistentValues();
+    }
+  }
+  start = {};
   std::vector<double> before(data(y), data(y) + n);
   calculateConsistentValues(tout1);
   check(IDAGetConsistentIC(ida, y, yp), "IDAGetConsistentIC");
@@ -557,11 +609,15 @@ void IdaSession::Impl::initialize(double tout1) {
     calculateConsistentValues(tout1);
     check(IDAGetConsistentIC(ida, y, yp), "IDAGetConsistentIC");
   }
-  calcIC = true;
+  initialValues = InitialValueMethod::CalcIC;
   noteChangedFixedStarts(before);
   if (hasAlgebraic) estimateAlgebraicRates(tout1);
-  // Automatic scales from the consistent values. IDA binds its tolerance data during its initial
-  // setup (which IDACalcIC has done), so new tolerances need a restart from the consistent point.
+  restartFromConsistentValues();
+}
+
+// Automatic scales from the consistent values. IDA binds its tolerance data during its initial
+// setup (which IDACalcIC has done), so new tolerances need a restart from the consistent point.
+void IdaSession::Impl::restartFromConsistentValues() {
   check(IDAReInit(ida, options.t0, y, yp), "IDAReInit");
   applyTolerances();
   if (yStep) {
@@ -718,7 +774,9 @@ SolverStats IdaSession::stats() const { return impl_->stats(); }
 const ToleranceSummary& IdaSession::tolerances() const { return impl_->tolerances.summary; }
 std::span<const double> IdaSession::absoluteTolerances() const { return impl_->tolerances.atol; }
 LinearSolverKind IdaSession::linearSolver() const { return impl_->kind; }
-bool IdaSession::computedInitialValues() const { return impl_->calcIC; }
+bool IdaSession::computedInitialValues() const { return impl_->initialValues != InitialValueMethod::AsGiven; }
+InitialValueMethod IdaSession::initialValueMethod() const { return impl_->initialValues; }
+std::optional<std::chrono::steady_clock::time_point> IdaSession::firstStepDone() const { return impl_->firstStepDone; }
 const std::vector<std::string>& IdaSession::warnings() const { return impl_->warnings; }
 
 }  // namespace qdot::rt

@@ -3,6 +3,7 @@
 // checking helper that turns every SUNDIALS return code into a sentence with the time (IdaError).
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -20,6 +21,13 @@ namespace qdot::rt {
 
 /// Which direct linear solver factors the Newton matrix.
 enum class LinearSolverKind { Auto, Dense, Klu };
+
+/// How the session made y'(t0) (and algebraic y(t0)) consistent with F = 0.
+enum class InitialValueMethod {
+  AsGiven,       ///< F(t0, y0, y'0) = 0 already
+  DiagonalRates, ///< every unknown differential and dF/dy' diagonal: y' from one exact division, verified
+  CalcIC,        ///< IDACalcIC (IDA_YA_YDP_INIT)
+};
 
 /// "auto", "dense" or "klu".
 std::string_view linearSolverName(LinearSolverKind kind);
@@ -107,7 +115,11 @@ class IdaSession {
   const ToleranceSummary& tolerances() const;  ///< the atol vector in use
   std::span<const double> absoluteTolerances() const;
   LinearSolverKind linearSolver() const;             ///< Dense or Klu (never Auto)
-  bool computedInitialValues() const;                ///< whether IDACalcIC ran
+  bool computedInitialValues() const;                ///< whether the start values were changed
+  InitialValueMethod initialValueMethod() const;
+  /// When IDA had completed its first step (seen at the next residual evaluation), if it has: the
+  /// time to the first step, which the setup alone does not show (IDA factors its first matrix there).
+  std::optional<std::chrono::steady_clock::time_point> firstStepDone() const;
   const std::vector<std::string>& warnings() const;  ///< IDA warnings and initialisation notes
 
  private:

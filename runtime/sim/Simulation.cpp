@@ -162,6 +162,7 @@ void collect(SimulationResult& r, const Session& session) {
   r.tolerances = session.tolerances();
   r.linearSolver = session.linearSolver();
   r.computedInitialValues = session.computedInitialValues();
+  r.initialValues = session.initialValueMethod();
   r.warnings = session.warnings();
   try {
     r.stats = session.stats();
@@ -290,6 +291,10 @@ SimulationResult simulateWith(const QdotModel& model, const SimulationSettings& 
     result.message = e.what();
   }
   (solving ? result.solveSeconds : result.setupSeconds) = secondsSince(clock);
+  result.firstStepSeconds = result.solveSeconds;
+  if constexpr (requires(Session& s) { s.firstStepDone(); })
+    if (solving && session->firstStepDone())
+      result.firstStepSeconds = std::chrono::duration<double>(*session->firstStepDone() - clock).count();
   try {
     sink.finish();
   } catch (const std::exception& e) {

@@ -80,10 +80,14 @@ struct SimulationResult {
   LinearSolverKind linearSolver = LinearSolverKind::Auto;  ///< as resolved (Auto if setup failed)
   bool linearSolverChosenAutomatically = false;            ///< --linear-solver auto
   bool computedInitialValues = false;
+  InitialValueMethod initialValues = InitialValueMethod::AsGiven;
   std::vector<std::string> warnings;
   SolverKind solver = SolverKind::Ida;  ///< the integrator that ran (never Auto)
   double setupSeconds = 0;  ///< wall time: session setup and consistent initial values
   double solveSeconds = 0;  ///< wall time: integration and writing
+  /// Wall time from the start of the solve to IDA's first completed step (its first matrix
+  /// factorization included); the whole solve if that was not seen (ARKODE, a run of one step).
+  double firstStepSeconds = 0;
 };
 
 /// Runs the model over the grid, writing into sink (begin, rows, finish). Never throws for

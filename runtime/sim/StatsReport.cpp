@@ -51,12 +51,16 @@ std::string formatStats(const SimulationResult& r) {
   if (s.initialNewtonIterations >= 0)
     line(out, "initial values", fmt::format("initialization system solved ({} Newton iterations)", s.initialNewtonIterations));
   else
-    line(out, "initial values", r.computedInitialValues ? "made consistent by IDACalcIC"
-                                : arkode           ? "consistent as given (y' = g(t0, y0))"
-                                                   : "consistent as given");
+    line(out, "initial values", r.initialValues == InitialValueMethod::CalcIC ? "made consistent by IDACalcIC"
+                                : r.initialValues == InitialValueMethod::DiagonalRates
+                                    ? "made consistent directly (dF/dy' diagonal: y' -= F/diag, checked)"
+                                : arkode ? "consistent as given (y' = g(t0, y0))"
+                                         : "consistent as given");
   line(out, "tolerances", toleranceText(r.tolerances));
   line(out, "rows written", fmt::format("{}", r.rows));
-  line(out, "wall time", fmt::format("setup {:.3f} s, solve {:.3f} s", r.setupSeconds, r.solveSeconds));
+  line(out, "wall time",
+       fmt::format("setup {:.3f} s, solve {:.3f} s (first step {:.3f} s)", r.setupSeconds, r.solveSeconds,
+                   r.firstStepSeconds));
   return out;
 }
 

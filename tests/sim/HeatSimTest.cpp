@@ -36,6 +36,26 @@ TEST(HeatRod, DecaysAsTheFirstModeOfTheSemiDiscreteSystem) {
   }
 }
 
+// The same rod as an energy balance per node, C T_i' = G (…) (tests/sim/models/rod_capacities.qd,
+// n = 40): rows that name their derivative with a factor stay one loop, and the decay rate is
+// G/C times the rod's, λ = 4 (G/C) sin²(π/(2(n + 1))). Bound as above.
+TEST(HeatRod, AnEnergyBalancePerNodeDecaysAtGOverCTimesTheRate) {
+  const int n = 40;
+  const double C = 4, G = 2, pi = 3.14159265358979, rtol = 1e-7;
+  const double lambda = 4 * (G / C) * std::pow(std::sin(pi / (2 * (n + 1))), 2);
+  auto r = runQdot("tests/sim/models/rod_capacities.qd", {"--rtol", num(rtol), "--stats"});
+  ASSERT_EQ(r.exitCode, 0) << r.log;
+  expectGrid(r, 0, 400, 20);
+  for (int i = 1; i <= n; ++i) {
+    double shape = std::sin(pi * i / (n + 1));
+    compareColumn(
+        r, "T[" + std::to_string(i) + "]", [&](double t) { return shape * std::exp(-lambda * t); },
+        [&](double) { return 2 * rtol; });
+  }
+  // y' at the start from the diagonal dF/dy' = C (runtime/ida/DiagonalRates.h), not IDACalcIC.
+  EXPECT_NE(r.log.find("made consistent directly"), std::string::npos) << r.log;
+}
+
 // A diffusivity of 1e300 makes ∂F/∂y so large that J(cj = 1) − J(cj = 0) cannot see the identity
 // ∂F/∂y': the start check must not claim that no equation contains der(T[i]) (every row does). The
 // run fails (no Newton iteration converges on eigenvalues of 1e300), saying so at t = 0.

@@ -520,10 +520,11 @@ TEST(VibrationLibrary, ElementsAndOffsetsTheExamplesLeaveOut) {
 // forces) and built from connected Vibration parts gives the same trajectory. Each run is within the
 // tolerance of the exact solution, so their difference is within twice oscillationBound.
 
-// Compares the component run's column `part` with the flat run's `flatName` (and their der()) at
-// every output time: |difference| ≤ 2 oscillationBound(A = amp, resp. vamp for the velocity).
+// Compares the component run's column `part` with the flat run's `flatName` (and their der(), or
+// the run's `partRate` where a variable of its own is the velocity) at every output time: |difference| ≤ 2 oscillationBound(A = amp, resp. vamp for the velocity).
 void expectSameTrajectory(const RunResult& flat, const RunResult& parts, const std::string& flatName,
-                          const std::string& part, double amp, double vamp, double period) {
+                          const std::string& part, double amp, double vamp, double period,
+                          const std::string& partRate = "") {
   ASSERT_EQ(flat.rows, parts.rows);
   auto flatAt = [&flat](const std::string& name) {  // the flat run's value at an output time (same grid)
     return [&flat, name](double time) {
@@ -533,7 +534,7 @@ void expectSameTrajectory(const RunResult& flat, const RunResult& parts, const s
     };
   };
   compareColumn(parts, part, flatAt(flatName), [&](double t) { return 2 * oscillationBound(kRtol, amp, period, t); });
-  compareColumn(parts, "der(" + part + ")", flatAt("der(" + flatName + ")"),
+  compareColumn(parts, partRate.empty() ? "der(" + part + ")" : partRate, flatAt("der(" + flatName + ")"),
                 [&](double t) { return 2 * oscillationBound(kRtol, vamp, period, t); });
 }
 
@@ -566,6 +567,22 @@ TEST(VibrationLibrary, ChainOfComponentArraysEqualsTheFlatChain) {
   for (int i = 1; i <= 10; ++i) {
     const std::string index = std::to_string(i);
     expectSameTrajectory(flat, parts, "x[" + index + "]", "ms[" + index + "].s", 0.1, 1, 2 * M_PI / 64);
+  }
+}
+
+// The chain written as Newton's law per mass (examples/vibration/spring_chain_equations.qd, its
+// interior `for` equations one loop each) moves as the chain derived from its energies: the same
+// equations of motion, reached by another path (no Euler–Lagrange derivation).
+TEST(VibrationLibrary, ChainWrittenAsEquationsMovesAsTheLagrangianChain) {
+  std::vector<std::string> args = {"--rtol", num(kRtol)};
+  auto energies = runQdot("examples/vibration/spring_chain.qd", args);
+  auto equations = runQdot("examples/vibration/spring_chain_equations.qd", args);
+  ASSERT_EQ(energies.exitCode, 0) << energies.log;
+  ASSERT_EQ(equations.exitCode, 0) << equations.log;
+  for (int i = 1; i <= 10; ++i) {
+    const std::string index = std::to_string(i);
+    expectSameTrajectory(energies, equations, "x[" + index + "]", "x[" + index + "]", 0.1, 1, 2 * M_PI / 64,
+                         "v[" + index + "]");
   }
 }
 

@@ -1,0 +1,48 @@
+#include "ida/DiagonalRates.h"
+
+#include <cmath>
+
+namespace qdot::rt {
+
+template <class Index>
+std::optional<DiagonalRates> diagonalRates(std::span<const Index> columnStarts, std::span<const Index> rowIndices,
+                                           std::span<const double> at0, std::span<const double> at1) {
+  size_t n = columnStarts.size() - 1;
+  constexpr uint32_t kNone = UINT32_MAX;
+  DiagonalRates r{std::vector<uint32_t>(n, kNone), std::vector<double>(n, 0.0)};
+  std::vector<uint32_t> columnOf(n, kNone);
+  for (size_t c = 0; c < n; ++c)
+    for (Index k = columnStarts[c]; k < columnStarts[c + 1]; ++k) {
+      if (at0[k] + 1.0 == at0[k] || !std::isfinite(at0[k])) return std::nullopt;  // the entry is unseen
+      double entry = at1[k] - at0[k];
+      if (entry == 0) continue;
+      auto row = static_cast<uint32_t>(rowIndices[k]);
+      if (r.rowOf[c] != kNone || columnOf[row] != kNone || !std::isfinite(entry)) return std::nullopt;
+      r.rowOf[c] = row, columnOf[row] = static_cast<uint32_t>(c), r.d[c] = entry;
+    }
+  for (uint32_t row : r.rowOf)
+    if (row == kNone) return std::nullopt;
+  return r;
+}
+
+template std::optional<DiagonalRates> diagonalRates<int32_t>(std::span<const int32_t>, std::span<const int32_t>,
+                                                             std::span<const double>, std::span<const double>);
+template std::optional<DiagonalRates> diagonalRates<int64_t>(std::span<const int64_t>, std::span<const int64_t>,
+                                                             std::span<const double>, std::span<const double>);
+
+void stepRates(const DiagonalRates& rates, std::span<const double> F, std::span<double> yp) {
+  for (size_t c = 0; c < yp.size(); ++c) yp[c] -= F[rates.rowOf[c]] / rates.d[c];
+}
+
+bool ratesConverged(const DiagonalRates& rates, std::span<const double> F, std::span<const double> y, double rtol,
+                    std::span<const double> atol, double span) {
+  constexpr double kIcNewtonTolerance = 0.33 * 0.01;  // IDA's epsNewt: 0.33 x IDASetNonlinConvCoefIC's 0.01
+  double sum = 0;
+  for (size_t c = 0; c < y.size(); ++c) {
+    double correction = F[rates.rowOf[c]] / rates.d[c] * span / (rtol * std::abs(y[c]) + atol[c]);
+    sum += correction * correction;
+  }
+  return y.empty() || std::sqrt(sum / static_cast<double>(y.size())) <= kIcNewtonTolerance;
+}
+
+}  // namespace qdot::rt
