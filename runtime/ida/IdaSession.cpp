@@ -105,6 +105,7 @@ struct IdaSession::Impl {
   double tout = 0;
   InitialValueMethod initialValues = InitialValueMethod::AsGiven;
   std::optional<std::chrono::steady_clock::time_point> firstStepDone;
+  bool blockTriangular = true;
 
   // What the last failure was, for the checking helper's message.
   bool modelFailed = false;
@@ -373,6 +374,19 @@ void IdaSession::Impl::applyTolerances(bool calibrated) {
   check(IDASVtolerances(ida, tolerances.solverRtol, atol), "IDASVtolerances");
 }
 
+namespace {
+
+// Whether every column c of a CSC pattern has an entry in row c.
+bool zeroFreeDiagonal(const std::vector<sunindextype>& columnStarts, const std::vector<sunindextype>& rowIndices) {
+  for (size_t c = 0; c + 1 < columnStarts.size(); ++c) {
+    auto begin = rowIndices.begin() + columnStarts[c], end = rowIndices.begin() + columnStarts[c + 1];
+    if (std::find(begin, end, static_cast<sunindextype>(c)) == end) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 void IdaSession::Impl::attachLinearSolver() {
   uint32_t nnz = model.jacobianNonzeros;
   kind = options.linearSolver == LinearSolverKind::Auto ? chooseLinearSolver(n, nnz) : options.linearSolver;
@@ -388,6 +402,13 @@ void IdaSession::Impl::attachLinearSolver() {
   if (kind == LinearSolverKind::Klu) {
     matrix = created(SUNSparseMatrix(n, n, std::max<uint32_t>(nnz, 1), CSC_MAT, context), "SUNSparseMatrix");
     solver = created(SUNLinSol_KLU(y, matrix, context), "SUNLinSol_KLU");
+    // KLU's block triangular form starts with a maximum transversal (BTF's maxtrans): one pass
+    // when the pattern's diagonal is zero-free, O(n · nnz) at worst otherwise — 92 s of the first
+    // step of a 10⁵-mass chain whose rows came in another order than its unknowns. Without a
+    // zero-free diagonal KLU factors the whole matrix instead (its fill-reducing ordering and
+    // partial pivoting), which for such a model took 0.09 s.
+    blockTriangular = zeroFreeDiagonal(columnStarts, rowIndices);
+    if (!blockTriangular) SUNLinSol_KLUGetCommon(solver)->btf = 0;
   } else {
     jacobianValues.assign(nnz, 0.0);
     matrix = created(SUNDenseMatrix(n, n, context), "SUNDenseMatrix");
@@ -776,6 +797,7 @@ std::span<const double> IdaSession::absoluteTolerances() const { return impl_->t
 LinearSolverKind IdaSession::linearSolver() const { return impl_->kind; }
 bool IdaSession::computedInitialValues() const { return impl_->initialValues != InitialValueMethod::AsGiven; }
 InitialValueMethod IdaSession::initialValueMethod() const { return impl_->initialValues; }
+bool IdaSession::blockTriangular() const { return impl_->blockTriangular; }
 std::optional<std::chrono::steady_clock::time_point> IdaSession::firstStepDone() const { return impl_->firstStepDone; }
 const std::vector<std::string>& IdaSession::warnings() const { return impl_->warnings; }
 

@@ -115,6 +115,9 @@ class IdaSession {
   const ToleranceSummary& tolerances() const;  ///< the atol vector in use
   std::span<const double> absoluteTolerances() const;
   LinearSolverKind linearSolver() const;             ///< Dense or Klu (never Auto)
+  /// KLU: whether it permutes the matrix to block triangular form first (not when the Jacobian's
+  /// diagonal has structural zeros: finding the permutation could then cost O(n · nnz)).
+  bool blockTriangular() const;
   bool computedInitialValues() const;                ///< whether the start values were changed
   InitialValueMethod initialValueMethod() const;
   /// When IDA had completed its first step (seen at the next residual evaluation), if it has: the

@@ -163,6 +163,7 @@ void collect(SimulationResult& r, const Session& session) {
   r.linearSolver = session.linearSolver();
   r.computedInitialValues = session.computedInitialValues();
   r.initialValues = session.initialValueMethod();
+  if constexpr (requires { session.blockTriangular(); }) r.blockTriangular = session.blockTriangular();
   r.warnings = session.warnings();
   try {
     r.stats = session.stats();

@@ -79,6 +79,7 @@ struct SimulationResult {
   ToleranceSummary tolerances;
   LinearSolverKind linearSolver = LinearSolverKind::Auto;  ///< as resolved (Auto if setup failed)
   bool linearSolverChosenAutomatically = false;            ///< --linear-solver auto
+  bool blockTriangular = true;  ///< KLU: permuted to block triangular form first (IdaSession::blockTriangular)
   bool computedInitialValues = false;
   InitialValueMethod initialValues = InitialValueMethod::AsGiven;
   std::vector<std::string> warnings;

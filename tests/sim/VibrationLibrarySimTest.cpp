@@ -586,6 +586,28 @@ TEST(VibrationLibrary, ChainWrittenAsEquationsMovesAsTheLagrangianChain) {
   }
 }
 
+// Expanded to scalars (--invariants keeps every model scalar), the equation chain's rows come in
+// another order than its unknowns, so the Jacobian's diagonal has structural zeros and KLU must not
+// start with its block triangular form (whose maximum transversal then costs O(n · nnz): 92 s at
+// n = 10⁵). It says so, and it and the looped run move as the Lagrangian chain (n = 300, KLU).
+TEST(VibrationLibrary, AnExpandedEquationChainIsFactoredWithoutBlockTriangularForm) {
+  std::vector<std::string> args = {"--rtol", num(kRtol), "-p", "n=300", "--stop", "0.2", "--stats"};
+  auto looped = runQdot("examples/vibration/spring_chain_equations.qd", args);
+  args.push_back("--invariants");
+  auto scalar = runQdot("examples/vibration/spring_chain_equations.qd", args);
+  auto energies = runQdot("examples/vibration/spring_chain.qd", args);
+  for (const auto* r : {&looped, &scalar, &energies}) ASSERT_EQ(r->exitCode, 0) << r->log;
+  const std::string without = "without block triangular form";
+  EXPECT_NE(scalar.log.find(without), std::string::npos) << scalar.log;
+  EXPECT_EQ(looped.log.find(without), std::string::npos) << looped.log;
+  EXPECT_EQ(energies.log.find(without), std::string::npos) << energies.log;
+  for (int i : {1, 150, 300}) {
+    const std::string x = "x[" + std::to_string(i) + "]", v = "v[" + std::to_string(i) + "]";
+    expectSameTrajectory(energies, looped, x, x, 0.1, 1, 2 * M_PI / 64, v);
+    expectSameTrajectory(energies, scalar, x, x, 0.1, 1, 2 * M_PI / 64, v);
+  }
+}
+
 // Reference: the Jacobi integral of a connected undamped system is its energy T + V (the flows of
 // each node cancel in the power balance). two_dof.qd: m1 = 1, m2 = 2, k1 = 100, k2 = 50, k3 = 100,
 // released from rest at s1 = 0.05: E = ½ k1 s1² + ½ k2 s1² = 0.1875 J, conserved; at rtol 1e-9 its
