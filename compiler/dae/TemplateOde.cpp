@@ -1,5 +1,5 @@
-// The DAE of an explicit ODE whose `for` equations stayed templates (TemplateOde.h): the check
-// that it is one, and its unknowns and rows, row j defining the derivative of unknown j.
+// The DAE of a model whose `for` equations stayed templates (TemplateOde.h): the check that each
+// row is matched to an unknown of its own, and its unknowns and rows, row j matched to unknown j.
 #include "dae/TemplateOde.h"
 
 #include <algorithm>
@@ -38,14 +38,18 @@ bool indexedInOrder(const flat::RelativeElement& rel, size_t iterators) {
   return true;
 }
 
-// Time, parameters, and unknowns that are states (every der() a variable of its own).
-bool unknownsAreStates(const flat::FlatModel& m) {
+// Time, parameters, and unknowns: states (every der() a variable of its own) and algebraic ones.
+bool onlyUnknownsAndParameters(const flat::FlatModel& m) {
   for (const flat::Variable& v : m.variables) {
     bool ok = v.role == VarRole::Time || v.role == VarRole::Parameter || v.role == VarRole::Derivative ||
-              (v.role == VarRole::Unknown && v.derivative >= 0);
+              v.role == VarRole::Unknown;
     if (!ok || v.alias) return false;
   }
   return true;
+}
+
+bool isAlgebraic(const flat::FlatModel& m, int v) {
+  return v >= 0 && m.variables[v].role == VarRole::Unknown && m.variables[v].derivative < 0;
 }
 
 bool onlyEquations(const flat::FlatModel& m) {
@@ -74,43 +78,46 @@ RowSymbols rowSymbols(const flat::FlatModel& m, const sym::Context& ctx, std::in
   return r;
 }
 
-// The relative symbol of the one derivative a template row names, `der(x)[%1,…]` with the
-// iterators in order and no offset, or null.
-const flat::RelativeElement* ownRate(const flat::FlatModel& m, const std::vector<Expr>& rates, size_t iterators) {
-  const flat::RelativeElement* own = rates.size() == 1 ? m.relativeElement(rates[0]) : nullptr;
-  if (!own || !indexedInOrder(*own, iterators)) return nullptr;
-  for (const auto& dim : own->dims)
-    if (dim.offset != 0) return nullptr;
-  return own;
+// `x[%1,…]`: subscripted by the iterators in order, without offsets.
+bool ownElement(const flat::RelativeElement& rel, size_t iterators) {
+  if (!indexedInOrder(rel, iterators)) return false;
+  for (const auto& dim : rel.dims)
+    if (dim.offset != 0) return false;
+  return true;
 }
 
+// The unknown a row is matched to: the one whose derivative is its only derivative (a state's
+// row: `der(x) = f`, `m*der(v)[%1] = f`), or, in a row without derivative, its only algebraic
+// unknown (`f = k*(x - x0)`, `f[%1] = k*(x[%1] - x[%1-1])`): ∂F/∂y' (resp. ∂F/∂y of the algebraic
+// unknowns) is then diagonal. For a template, the array (its first element's unknown).
 class OdeCheck {
  public:
   OdeCheck(const flat::FlatModel& m, const sym::Context& ctx) : m_(m), ctx_(ctx), firstUnknown_(m.patterns->arrays.size(), -2) {}
 
-  // The unknown whose derivative a scalar row names, its only one (`der(x) = rhs`, `m*der(v) = f`,
-  // over unknowns, parameters and time), or -1.
+  // The unknown a scalar row is matched to (over unknowns, parameters and time), or -1.
   int scalarRow(const flat::Equation& e) const {
     RowSymbols s = rowSymbols(m_, ctx_, {e.residual});
-    for (Expr other : s.others)
-      if (m_.variableOf(other) < 0) return -1;
-    return s.rates.size() == 1 ? unknownOfRate(m_, s.rates[0]) : -1;
+    int algebraic = -1, count = 0;
+    for (Expr other : s.others) {
+      int v = m_.variableOf(other);
+      if (v < 0) return -1;
+      if (isAlgebraic(m_, v)) algebraic = v, ++count;
+    }
+    if (s.rates.size() == 1) return unknownOfRate(m_, s.rates[0]);
+    return s.rates.empty() && count == 1 ? algebraic : -1;
   }
 
-  // The unknown of the first element of the array whose derivatives a template row names, its only
-  // derivative `der(x)[%1,…]` (`der(x)[%1] = rhs`, `m*der(v)[%1] = f`), or -1. The row reads arrays
-  // of unknowns and of parameters (ldpl) by the template's iterators in order.
+  // The unknown of the first element of the array a template row is matched to, or -1. The row
+  // reads arrays of unknowns and of parameters (ldpl) by the template's iterators in order.
   int templateRow(const flat::EquationTemplate& t) {
-    RowSymbols s = rowSymbols(m_, ctx_, {t.lhs, t.rhs});
-    const flat::RelativeElement* own = ownRate(m_, s.rates, t.box.size());
+    const flat::ArrayVariable* own = ownArray(t);
     if (!own) return -1;
-    const flat::ArrayVariable& rates = m_.patterns->arrays[own->array];
-    int first = firstOfConsecutive(rates, [&](Expr e) { return unknownOfRate(m_, e); });
-    for (Expr other : s.others) {
+    int first = unknownOfElement(own->elements[0]);
+    for (Expr other : rowSymbols(m_, ctx_, {t.lhs, t.rhs}).others) {
       if (const flat::RelativeElement* rel = m_.relativeElement(other)) {
-        if (flat::loopableParameters(m_, *rel, t.box.size(), rates.shape)) continue;
+        if (flat::loopableParameters(m_, *rel, t.box.size(), own->shape)) continue;
         const flat::ArrayVariable& a = m_.patterns->arrays[rel->array];
-        bool shaped = t.box.size() == 1 || a.shape == rates.shape;
+        bool shaped = t.box.size() == 1 || a.shape == own->shape;
         if (!indexedInOrder(*rel, t.box.size()) || !shaped || firstUnknown(rel->array) < 0) return -1;
         continue;
       }
@@ -118,6 +125,33 @@ class OdeCheck {
       if (v < 0 || (m_.variables[v].role != VarRole::Parameter && m_.variables[v].role != VarRole::Time)) return -1;
     }
     return first;
+  }
+
+  // The array whose elements' rows a template gives (of derivatives or of algebraic unknowns),
+  // consecutive unknowns, or null.
+  const flat::ArrayVariable* ownArray(const flat::EquationTemplate& t) {
+    RowSymbols s = rowSymbols(m_, ctx_, {t.lhs, t.rhs});
+    const flat::RelativeElement* own = nullptr;
+    if (s.rates.size() == 1) {
+      own = m_.relativeElement(s.rates[0]);
+    } else if (s.rates.empty()) {
+      for (Expr other : s.others) {
+        const flat::RelativeElement* rel = m_.relativeElement(other);
+        if (!rel || !isAlgebraic(m_, m_.variableOf(m_.patterns->arrays[rel->array].elements[0]))) continue;
+        if (own) return nullptr;  // two algebraic arrays, or two elements of one
+        own = rel;
+      }
+    }
+    if (!own || !ownElement(*own, t.box.size())) return nullptr;
+    const flat::ArrayVariable& a = m_.patterns->arrays[own->array];
+    return firstOfConsecutive(a, [&](Expr e) { return unknownOfElement(e); }) >= 0 ? &a : nullptr;
+  }
+
+  // The unknown an element stands for: x for der(x), the unknown itself otherwise; -1 if none.
+  int unknownOfElement(Expr e) const {
+    int v = m_.variableOf(e);
+    if (v >= 0 && m_.variables[v].role == VarRole::Derivative) return m_.variables[v].derivativeOf;
+    return v >= 0 && m_.variables[v].role == VarRole::Unknown ? v : -1;
   }
 
  private:
@@ -136,16 +170,11 @@ class OdeCheck {
   }
 };
 
-// The array whose derivatives a template (of a templated ODE) defines.
-const flat::ArrayVariable& definedArray(const flat::FlatModel& m, const sym::Context& ctx, const flat::EquationTemplate& t) {
-  return m.patterns->arrays[ownRate(m, rowSymbols(m, ctx, {t.lhs, t.rhs}).rates, t.box.size())->array];
-}
-
 }  // namespace
 
 bool isTemplatedOde(const flat::FlatModel& m, const sym::Context& ctx) {
-  if (m.equationTemplates.empty() || !onlyEquations(m) || !unknownsAreStates(m)) return false;
-  std::vector<int> rows(m.variables.size(), 0);  // per unknown: the rows defining its derivative
+  if (m.equationTemplates.empty() || !onlyEquations(m) || !onlyUnknownsAndParameters(m)) return false;
+  std::vector<int> rows(m.variables.size(), 0);  // per unknown: the rows matched to it
   OdeCheck check(m, ctx);
   for (const flat::Equation& e : m.equations) {
     int x = check.scalarRow(e);
@@ -155,7 +184,7 @@ bool isTemplatedOde(const flat::FlatModel& m, const sym::Context& ctx) {
   for (const flat::EquationTemplate& t : m.equationTemplates) {
     int first = check.templateRow(t);
     if (first < 0) return false;
-    const std::vector<int>& shape = definedArray(m, ctx, t).shape;
+    const std::vector<int>& shape = check.ownArray(t)->shape;
     flat::forEachPoint(t.box, [&](std::span<const long> p, size_t) { ++rows[first + flat::linearIndex(shape, p)]; });
   }
   for (size_t i = 0; i < m.variables.size(); ++i)
@@ -169,8 +198,10 @@ void addTemplatedOde(const flat::FlatModel& m, sym::Context& ctx, Dae& dae) {
     const flat::Variable& f = m.variables[i];
     if (f.role != VarRole::Unknown) continue;
     unknown[i] = static_cast<int>(dae.variables.size());
-    dae.variables.push_back({.name = std::string(f.name), .kind = VarKind::State, .role = UnknownRole::State,
-                             .y = f.symbol, .yp = m.variables[f.derivative].symbol, .flatVar = i, .declaration = f});
+    bool state = f.derivative >= 0;
+    dae.variables.push_back({.name = std::string(f.name), .kind = state ? VarKind::State : VarKind::Algebraic,
+                             .role = state ? UnknownRole::State : UnknownRole::Algebraic, .y = f.symbol,
+                             .yp = state ? m.variables[f.derivative].symbol : nullptr, .flatVar = i, .declaration = f});
   }
   dae.equations.resize(dae.variables.size());
   std::vector<char> placed(dae.equations.size(), 0);
@@ -185,11 +216,11 @@ void addTemplatedOde(const flat::FlatModel& m, sym::Context& ctx, Dae& dae) {
     dae.equations[row] = e;
   }
   for (const flat::EquationTemplate& t : m.equationTemplates) {
-    const flat::ArrayVariable& rates = definedArray(m, ctx, t);
-    int first = unknown[unknownOfRate(m, rates.elements[0])];
-    dae.templateBlocks.push_back({first, rates.shape, t.box, ctx.sub(t.lhs, t.rhs), flat::OriginKind::Equation, t.origin.range});
+    const flat::ArrayVariable& own = *check.ownArray(t);
+    int first = unknown[check.unknownOfElement(own.elements[0])];
+    dae.templateBlocks.push_back({first, own.shape, t.box, ctx.sub(t.lhs, t.rhs), flat::OriginKind::Equation, t.origin.range});
     flat::forEachPoint(t.box, [&](std::span<const long> p, size_t) {
-      int row = first + static_cast<int>(flat::linearIndex(rates.shape, p));
+      int row = first + static_cast<int>(flat::linearIndex(own.shape, p));
       place(row);
       dae.equations[row].origin = t.origin;
     });

@@ -113,18 +113,20 @@ void returnFreedMemory() {
 
 // Whether `for` equations may stay templates (docs/loops.md), from the syntax: a run that keeps
 // loops and needs no invariants, of a model of equations only — no mechanics, initial equations or
-// components — with a `for` loop of equations naming one derivative each (`der(x[i]) = …`,
-// `m*der(v[i]) = …`, flat::mayKeepForEquation). Flattening then keeps them only if the model is an
-// ODE with one derivative per row (dae::isTemplatedOde), else it flattens again.
+// components — with `for` loops of equations naming at most one derivative each (`der(x[i]) = …`,
+// `m*der(v[i]) = …`, `f[i] = …`; flat::mayKeepForEquation), one of them naming some. Flattening
+// then keeps them only if each row is matched to its own unknown (dae::isTemplatedOde), else it
+// flattens again.
 bool forEquationsMayStay(const Compilation& c) {
   const sema::CheckedClass& root = *c.checked->root;
   if (!c.options.keepLoops || c.options.keepInvariants || !root.mechanics.empty() || !root.initialEquations.empty())
     return false;
   for (const auto& [name, symbol] : root.symbols)
     if (symbol.kind == sema::SymbolKind::Component) return false;
-  return std::any_of(root.equations.begin(), root.equations.end(), [](const ast::Equation* eq) {
-    return eq->kind == ast::EquationKind::For && flat::mayKeepForEquation(*eq);
-  });
+  auto keepable = [](const ast::Equation* eq) { return eq->kind == ast::EquationKind::For && flat::mayKeepForEquation(*eq); };
+  auto withRates = [](const ast::Equation* eq) { return eq->kind == ast::EquationKind::For && flat::namesDerivatives(*eq); };
+  return std::any_of(root.equations.begin(), root.equations.end(), keepable) &&
+         std::any_of(root.equations.begin(), root.equations.end(), withRates);
 }
 
 // Flattening with the `for` equations kept as templates, silently (its diagnostics are dropped):

@@ -20,17 +20,20 @@ struct FlattenLimits {
   /// Keep `sum(... for i in a:b)` in energies as IndexedSums (templates) where its body indexes
   /// arrays by the iterator plus constants (docs/loops.md); otherwise every sum is expanded.
   bool keepLoops = false;
-  /// Keep top-level `for` equations each naming one derivative, of an element `der(x[i, …])` with
-  /// the iterators in order (`der(x[i]) = rhs`, `m*der(v[i]) = f`), whose sides index arrays by the
-  /// iterators plus constants, as EquationTemplates (docs/loops.md); any other equation is expanded.
+  /// Keep top-level `for` equations each naming at most one derivative, of an element `der(x[i, …])`
+  /// with the iterators in order (`der(x[i]) = rhs`, `m*der(v[i]) = f`, `f[i] = k*(x[i] - x[i-1])`),
+  /// whose sides index arrays by the iterators plus constants, as EquationTemplates (docs/loops.md);
+  /// any other equation is expanded.
   /// Only for a model the pipeline then checks with dae::isTemplatedOde (else it flattens again).
   bool keepForEquations = false;
 };
 
 /// Whether the syntax of a `for` equation allows keepForEquations to keep it (the flattener decides
-/// with the names resolved): loops nested one in the next, around equations that each contain one
-/// der() call, of an indexed name.
+/// with the names resolved): loops nested one in the next, around equations that each contain at
+/// most one der() call, of an indexed name (an equation without one is an algebraic row).
 bool mayKeepForEquation(const ast::Equation& loop);
+/// Whether a `for` equation contains a der() call (a model without one has nothing to keep).
+bool namesDerivatives(const ast::Equation& loop);
 
 /// Values that replace the bindings of scalar Integer parameters (`qdot run -p n=3`): the model
 /// is flattened as if they were written there, so the arrays they size take the new sizes. Every

@@ -267,12 +267,13 @@ bool collectDerCalls(const ast::Expr& e, std::vector<const CallExpr*>& calls) {
   }
 }
 
-// The one der() call of an equation, or null.
-const CallExpr* onlyDerCall(const ast::Equation& eq) {
-  if (eq.kind != EquationKind::Simple || !eq.lhs || !eq.rhs) return nullptr;
+// The der() calls of a simple equation: none (an algebraic row) or one; nullopt for more, or for
+// an equation of another kind.
+std::optional<const CallExpr*> derCallOf(const ast::Equation& eq) {
+  if (eq.kind != EquationKind::Simple || !eq.lhs || !eq.rhs) return std::nullopt;
   std::vector<const CallExpr*> calls;
-  if (!collectDerCalls(*eq.lhs, calls) || !collectDerCalls(*eq.rhs, calls) || calls.size() != 1) return nullptr;
-  return calls[0];
+  if (!collectDerCalls(*eq.lhs, calls) || !collectDerCalls(*eq.rhs, calls) || calls.size() > 1) return std::nullopt;
+  return calls.empty() ? nullptr : calls[0];
 }
 
 }  // namespace
@@ -280,8 +281,14 @@ const CallExpr* onlyDerCall(const ast::Equation& eq) {
 bool mayKeepForEquation(const ast::Equation& loop) {
   if (loop.kind == EquationKind::For)
     return !loop.body.empty() && std::all_of(loop.body.begin(), loop.body.end(), mayKeepForEquation);
-  const CallExpr* der = onlyDerCall(loop);
-  return der && der->args.size() == 1 && dyn_cast<IndexExpr>(der->args[0].get());
+  std::optional<const CallExpr*> der = derCallOf(loop);
+  return der && (!*der || ((*der)->args.size() == 1 && dyn_cast<IndexExpr>((*der)->args[0].get())));
+}
+
+bool namesDerivatives(const ast::Equation& loop) {
+  if (loop.kind == EquationKind::For) return std::any_of(loop.body.begin(), loop.body.end(), namesDerivatives);
+  std::optional<const CallExpr*> der = derCallOf(loop);
+  return der && *der;
 }
 
 // The iterators of a top-level `for` equation and of the loops nested in it while each loop holds
@@ -319,8 +326,8 @@ bool Flattener::lowerEquationTemplates(const ast::Equation& loop) {
 std::optional<EquationTemplate> Flattener::lowerEquationTemplate(const ast::Equation& eq,
                                                                  const std::vector<TemplateIterator>& its) {
   TemplateCheck check(its);
-  const CallExpr* der = onlyDerCall(eq);
-  if (!der || !isOwnDerivative(*der, check, its.size()) || !check.body(*eq.lhs) || !check.body(*eq.rhs))
+  std::optional<const CallExpr*> der = derCallOf(eq);
+  if (!der || (*der && !isOwnDerivative(**der, check, its.size())) || !check.body(*eq.lhs) || !check.body(*eq.rhs))
     return std::nullopt;
   EquationTemplate t;
   templateIterators_ = its;

@@ -586,6 +586,22 @@ TEST(VibrationLibrary, ChainWrittenAsEquationsMovesAsTheLagrangianChain) {
   }
 }
 
+// The chain with its link forces as algebraic unknowns (tests/sim/models/chain_forces.qd, every
+// `for` equation one loop: an index-1 DAE whose algebraic rows each define their own unknown) moves
+// as the chain derived from its energies.
+TEST(VibrationLibrary, ChainWithLinkForcesMovesAsTheLagrangianChain) {
+  std::vector<std::string> args = {"--rtol", num(kRtol)};
+  auto energies = runQdot("examples/vibration/spring_chain.qd", args);
+  auto forces = runQdot("tests/sim/models/chain_forces.qd", args);
+  ASSERT_EQ(energies.exitCode, 0) << energies.log;
+  ASSERT_EQ(forces.exitCode, 0) << forces.log;
+  for (int i = 1; i <= 10; ++i) {
+    const std::string index = std::to_string(i);
+    expectSameTrajectory(energies, forces, "x[" + index + "]", "x[" + index + "]", 0.1, 1, 2 * M_PI / 64,
+                         "v[" + index + "]");
+  }
+}
+
 // Expanded to scalars (--invariants keeps every model scalar), the equation chain's rows come in
 // another order than its unknowns, so the Jacobian's diagonal has structural zeros and KLU must not
 // start with its block triangular form (whose maximum transversal then costs O(n · nnz): 92 s at
