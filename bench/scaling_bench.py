@@ -12,6 +12,9 @@ For each n, one fresh process each (peak memory by wait4's ru_maxrss):
 Prints a markdown table (time per stage, file to first step, peak memory, both programs side by
 side) and the fitted exponent of each column between consecutive sizes (t ~ n^k).
 
+Then the ways of writing repeated structure (FORMS: energies with arrays of parameters, `for`
+equations with implicit rows or algebraic unknowns) as templates against expanded to scalars.
+
 Then the whole process at issue 15's setting (rtol 1e-6, 1 s, KLU, columns x[1] and x[n]) for
 n = 10^3 ... 10^5 (--whole-sizes): `qdot run` in its default mode (tiering) against the hand-written
 program, wall time and peak memory, best of --repeat runs (one fresh process each).
@@ -110,6 +113,39 @@ def small_models(build, repeat):
         print(f"| {name} | {inside * 1e3:.2f} | {wall * 1e3:.1f} |")
 
 
+# Models whose repeated structure is written other ways than the chain's energies (docs/loops.md):
+# each as templates (qdot run's default) and expanded to scalars (--invariants keeps every stage
+# scalar), at n = 10^5, to t = 1e-4 s.
+FORMS = [("spring chain, energies", CHAIN, "x[1]"),
+         ("non-uniform chain, energies with m[i], k[i]", "examples/vibration/nonuniform_chain.qd", "x[1]"),
+         ("spring chain, `m*der(v[i]) = …` equations", "examples/vibration/spring_chain_equations.qd", "x[1]"),
+         ("spring chain, link forces f[i] as unknowns", "tests/sim/models/chain_forces.qd", "x[1]"),
+         ("heat rod, `der(T[i]) = …`", "examples/heat/rod.qd", "T[1]")]
+
+
+def forms(build, n, repeat):
+    """Each FORMS model as templates and as scalars: compile time (--stats), whole process, peak."""
+    size = f"{n:,}".replace(",", " ")
+    print(f"\n## Ways of writing repeated structure, n = {size}: templates against scalars "
+          f"(to t = 1e-4 s, --jit-wait, best of {repeat})\n")
+    print("| model | compile, templates [s] | whole, templates [s] | peak, templates [MiB] | compile, scalars [s] "
+          "| whole, scalars [s] | peak, scalars [MiB] | **whole: scalars / templates** |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for name, path, column in FORMS:
+        cells = []
+        for extra in ([], ["--invariants"]):
+            command = [f"{build}/qdot", "run", path, "-p", f"n={n}", "--stop", "1e-4", "--interval", "1e-4",
+                       "--outputs", column, "-o", "/dev/null", "--stats", "--jit-wait", "--no-progress"] + extra
+            best = (float("inf"), float("inf"), float("inf"))
+            for _ in range(repeat):
+                wall, peak, err = peak_of(command)
+                compile_s = number(r"; total ([0-9.e+-]+)", err) / 1e3
+                best = tuple(min(a, b) for a, b in zip(best, (compile_s, wall, peak)))
+            cells.append(best)
+        (tc, tw, tp), (sc, sw, sp) = cells
+        print(f"| {name} | {tc:.2f} | {tw:.2f} | {tp:.0f} | {sc:.2f} | {sw:.2f} | {sp:.0f} | **{sw / tw:.1f}** |")
+
+
 def print_whole(rows, stop, repeat):
     print(f"\n## Whole process, issue 15's setting (rtol 1e-6, {stop:g} s, KLU, columns x[1], x[n]; "
           f"default mode; best of {repeat})\n")
@@ -135,6 +171,7 @@ def main():
     ap.add_argument("--whole-sizes", default=None, help="n for the whole-process table (default 1000,10000,100000; 'none' skips it)")
     ap.add_argument("--whole-stop", type=float, default=1.0)
     ap.add_argument("--repeat", type=int, default=1)
+    ap.add_argument("--forms-n", type=int, default=100000, help="n of the ways-of-writing table (0 skips it)")
     a = ap.parse_args()
     sizes = [int(s) for s in a.sizes.split(",")] if a.sizes else ([1000, 10000, 100000] if a.quick else
                                                                    [1000, 10000, 100000, 1000000])
@@ -161,6 +198,8 @@ def main():
         for x, y in zip(rows, rows[1:]):
             print(f"| {x['n']} → {y['n']} | " + " | ".join(f"{exponent(x, y, c):.2f}" for c in cols) + " |")
     small_models(a.build, 10)
+    if a.forms_n:
+        forms(a.build, a.forms_n, a.repeat)
     if a.whole_sizes != "none":
         whole_sizes = [int(s) for s in a.whole_sizes.split(",")] if a.whole_sizes else (
             [1000, 10000] if a.quick else [1000, 10000, 100000])
