@@ -104,8 +104,8 @@ class Builder {
 
   Variable fromFlat(int index, VarKind kind, UnknownRole role) {
     const flat::Variable& f = m_.variables[index];
-    return Variable{.name = std::string(f.name), .kind = kind, .role = role, .y = f.symbol, .flatVar = index,
-                    .declaration = f};
+    return Variable{.name = std::string(f.name), .kind = kind, .role = role, .flatVar = index, .y = f.symbol,
+                    .declaration = Declaration::of(f)};
   }
 
   void addParameters() {
@@ -209,11 +209,8 @@ class Builder {
                           std::make_move_iterator(algebraic.end()));
     for (const auto& mult : eom_.multipliers) {
       const auto& c = m_.constraints[mult.constraint];
-      flat::Variable declaration{.name = ctx_.symbolName(mult.symbol), .role = flat::VarRole::Multiplier,
-                                 .symbol = mult.symbol, .declRange = c.origin.range,
-                                 .description = "Lagrange multiplier of the constraint"};
       dae_.variables.push_back({.name = mult.name, .kind = VarKind::Algebraic, .role = UnknownRole::Multiplier,
-                                .y = mult.symbol, .declaration = declaration});
+                                .y = mult.symbol, .declaration = {.declRange = c.origin.range}});
     }
   }
 

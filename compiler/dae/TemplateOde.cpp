@@ -131,8 +131,8 @@ void addTemplatedOde(const flat::FlatModel& m, sym::Context& ctx, Dae& dae) {
     const flat::Variable& f = m.variables[i];
     if (f.role != VarRole::Unknown) continue;
     unknown[i] = static_cast<int>(dae.variables.size());
-    dae.variables.push_back({.name = std::string(f.name), .kind = VarKind::State, .role = UnknownRole::State,
-                             .y = f.symbol, .yp = m.variables[f.derivative].symbol, .flatVar = i, .declaration = f});
+    dae.variables.push_back({.name = std::string(f.name), .kind = VarKind::State, .role = UnknownRole::State, .flatVar = i,
+                             .y = f.symbol, .yp = m.variables[f.derivative].symbol, .declaration = Declaration::of(f)});
   }
   dae.equations.resize(dae.variables.size());
   std::vector<char> placed(dae.equations.size(), 0);
