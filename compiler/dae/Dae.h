@@ -32,8 +32,10 @@ struct Declaration {
   sym::Expr start = nullptr;
   sym::Expr nominal = nullptr;
 
-  static Declaration of(const flat::Variable& f) {
-    return {.declRange = f.declRange, .fixed = f.fixed, .fixedGiven = f.fixedGiven, .start = f.start, .nominal = f.nominal};
+  static Declaration of(const flat::FlatModel& m, int variable) {
+    const flat::Variable& f = m.variables[variable];
+    return {.declRange = f.declRange, .fixed = f.fixed, .fixedGiven = f.fixedGiven, .start = f.start,
+            .nominal = m.attributesOf(f).nominal};
   }
 };
 

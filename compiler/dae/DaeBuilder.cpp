@@ -105,15 +105,15 @@ class Builder {
   Variable fromFlat(int index, VarKind kind, UnknownRole role) {
     const flat::Variable& f = m_.variables[index];
     return Variable{.name = std::string(f.name), .kind = kind, .role = role, .flatVar = index, .y = f.symbol,
-                    .declaration = Declaration::of(f)};
+                    .declaration = Declaration::of(m_, index)};
   }
 
   void addParameters() {
     for (const auto& f : m_.variables)
       if (f.role == flat::VarRole::Parameter)
         dae_.parameters.push_back(
-            {std::string(f.name), f.symbol, f.value, std::string(f.description), std::string(f.unit), f.declRange,
-             f.input});
+            {std::string(f.name), f.symbol, f.value, std::string(m_.attributesOf(f).description),
+             std::string(m_.attributesOf(f).unit), f.declRange, f.input});
   }
 
   // Coordinates first, then velocities (spec §5). A coordinate whose row contains no velocity at

@@ -132,7 +132,7 @@ void addTemplatedOde(const flat::FlatModel& m, sym::Context& ctx, Dae& dae) {
     if (f.role != VarRole::Unknown) continue;
     unknown[i] = static_cast<int>(dae.variables.size());
     dae.variables.push_back({.name = std::string(f.name), .kind = VarKind::State, .role = UnknownRole::State, .flatVar = i,
-                             .y = f.symbol, .yp = m.variables[f.derivative].symbol, .declaration = Declaration::of(f)});
+                             .y = f.symbol, .yp = m.variables[f.derivative].symbol, .declaration = Declaration::of(m, i)});
   }
   dae.equations.resize(dae.variables.size());
   std::vector<char> placed(dae.equations.size(), 0);

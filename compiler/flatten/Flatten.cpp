@@ -404,8 +404,13 @@ Value Flattener::variablesFor(const Declaration& d, const std::vector<int>& shap
     names.chars += name;
     names.finish();
   });
+  int attributes = 0;  // one record for the declaration's description, shared by its elements
+  if (!d.description.empty()) {
+    attributes = static_cast<int>(out_.attributes.size());
+    out_.attributes.push_back({.description = d.description});
+  }
   for (Expr symbol : ctx_.symbols(names.views())) {
-    addVariable({.role = role, .symbol = symbol, .declRange = where, .description = d.description});
+    addVariable({.role = role, .symbol = symbol, .declRange = where, .attributes = attributes});
     v.elems.push_back(symbol);
   }
   slot.variables = std::move(v);
@@ -460,7 +465,7 @@ void Flattener::applyAttributeList(const std::vector<ast::Modification>& mods, c
     if (!mod.value) continue;
     if (mod.name == "unit") {
       if (auto* s = dyn_cast<StringExpr>(mod.value.get()))
-        for (Expr x : vars.elems) out_.variables[out_.variableOf(x)].unit = s->value;
+        setAttribute(vars, true, [&](VariableAttributes& a, size_t) { a.unit = s->value; });
       continue;
     }
     if (mod.name != "start" && mod.name != "fixed" && mod.name != "nominal" && mod.name != "min" && mod.name != "max")
@@ -476,16 +481,42 @@ void Flattener::applyAttributeList(const std::vector<ast::Modification>& mods, c
       v = lower(*mod.value);
     }
     if (!v.isScalar()) checkShape(v, vars.shape, mod.value->range, "the " + mod.name + " value of '" + name + "'");
+    auto element = [&](size_t i) { return v.isScalar() ? v.elems[0] : v.elems[i]; };
+    if (mod.name == "nominal" || mod.name == "min" || mod.name == "max") {
+      Expr VariableAttributes::*field = mod.name == "nominal" ? &VariableAttributes::nominal
+                                        : mod.name == "min"   ? &VariableAttributes::min
+                                                              : &VariableAttributes::max;
+      setAttribute(vars, v.isScalar(), [&](VariableAttributes& a, size_t i) { a.*field = element(i); });
+      continue;
+    }
     for (size_t i = 0; i < vars.size(); ++i) {
       Variable& var = out_.variables[out_.variableOf(vars.elems[i])];
-      Expr x = v.isScalar() ? v.elems[0] : v.elems[i];
+      Expr x = element(i);
       if (mod.name == "start") var.start = x;
-      else if (mod.name == "nominal") var.nominal = x;
-      else if (mod.name == "min") var.min = x;
-      else if (mod.name == "max") var.max = x;
       else if (!x->isConstant()) fail(mod.value->range, DiagCode::E0303, "'fixed' must be true or false");
       else var.fixed = x->value != 0, var.fixedGiven = true;
     }
+  }
+}
+
+// set(attributes, i) on a copy of the record of element i of `vars`, which then refers to the copy.
+// With the same value for all (`sameForAll`), elements that shared a record share the new one.
+void Flattener::setAttribute(const Value& vars, bool sameForAll,
+                             const std::function<void(VariableAttributes&, size_t)>& set) {
+  std::unordered_map<int, int> copies;  // record before -> record after (sameForAll)
+  for (size_t i = 0; i < vars.size(); ++i) {
+    Variable& var = out_.variables[out_.variableOf(vars.elems[i])];
+    if (sameForAll)
+      if (auto it = copies.find(var.attributes); it != copies.end()) {
+        var.attributes = it->second;
+        continue;
+      }
+    VariableAttributes copy = out_.attributes[var.attributes];
+    set(copy, i);
+    int index = static_cast<int>(out_.attributes.size());
+    out_.attributes.push_back(copy);
+    if (sameForAll) copies.emplace(var.attributes, index);
+    var.attributes = index;
   }
 }
 
