@@ -57,7 +57,7 @@ class Builder {
   sym::Context& ctx_;
   DiagnosticEngine& diags_;
   Dae dae_;
-  std::vector<Equation> kinematic_;
+  size_t firstKinematic_ = 0;  ///< where addMechanics appended the kinematic rows
   enum RowKind : char { Skip, Algebraic, NotInertial, Inertial };  ///< of a coordinate's row, in addMechanics
   std::vector<char> kinematicTaken_;  ///< per kinematic row (templated models): a template's
   std::vector<std::pair<int, int>> kinematicPairs_;  ///< per kinematic row: coordinate, velocity (index among velocities)
@@ -133,7 +133,7 @@ class Builder {
       kindOf[r] = inertial ? Inertial : appears(v.symbol) ? NotInertial : Algebraic;
     }
     size_t states = std::count_if(kindOf.begin(), kindOf.end(), [](char k) { return k == Inertial || k == NotInertial; });
-    kinematic_.reserve(states);
+    firstKinematic_ = dae_.equations.size();  // appended in place (addEquations reserved room)
     kinematicPairs_.reserve(states);
     std::vector<Expr> rates = rateSymbols(kindOf);
     size_t state = 0;
@@ -149,7 +149,7 @@ class Builder {
       qv.yp = rates[state++];
       // A templated model's kinematic rows are made when addTemplateBlocks has taken its arrays'.
       Expr residual = eom_.templateRows.empty() ? ctx_.sub(qv.yp, m_.variables[q.derivative].symbol) : nullptr;
-      kinematic_.push_back({residual, {flat::OriginKind::Kinematic, q.declRange, eom_.rows[r].coordinate, ""}});
+      dae_.equations.push_back({residual, {flat::OriginKind::Kinematic, q.declRange, eom_.rows[r].coordinate, ""}});
       kinematicPairs_.push_back({static_cast<int>(dae_.variables.size()), static_cast<int>(kinematicPairs_.size())});
       dae_.variables.push_back(std::move(qv));
     }
@@ -295,10 +295,12 @@ class Builder {
   }
 
   // The kinematic rows go after the Euler–Lagrange rows (made by addMechanics, which needs to
-  // know which symbols the other equations contain).
+  // know which symbols the other equations contain, and appends them): rotated past the other
+  // equations, a few in most models, rather than copied from a temporary (a row per coordinate).
   void insertKinematicRows() {
-    dae_.equations.insert(dae_.equations.begin() + static_cast<long>(eom_.rows.size()),
-                          std::make_move_iterator(kinematic_.begin()), std::make_move_iterator(kinematic_.end()));
+    auto first = dae_.equations.begin();
+    std::rotate(first + static_cast<long>(eom_.rows.size()), first + static_cast<long>(firstKinematic_),
+                dae_.equations.end());
   }
 };
 
