@@ -42,12 +42,16 @@ static void forEachScalarName(const std::string& base, const std::vector<int>& s
 namespace {
 
 // Many names in one buffer instead of a string each; viewed once all are written (the buffer moves
-// while it grows).
+// while it grows). A large array's names go through it in batches (full(), then clear()): the
+// buffers stay small and in cache instead of growing to tens of bytes per element.
 struct NameBuffer {
+  static constexpr size_t kBatch = 4096;
   std::string chars;
   std::vector<size_t> ends;
   /// The characters appended since the previous name are a name.
   void finish() { ends.push_back(chars.size()); }
+  bool full() const { return ends.size() >= kBatch; }
+  void clear() { chars.clear(), ends.clear(); }
   std::vector<std::string_view> views() const {
     std::vector<std::string_view> out;
     out.reserve(ends.size());
@@ -193,11 +197,18 @@ int Flattener::addDerivative(int var, VarRole role, Expr symbol) {
 }
 
 // Every coordinate has a velocity and an acceleration, used or not: der(x[1]), der(der(x[1])),
-// der(x[2]), … in the order derivativeVariable would make them, with their symbols made at once
-// (Context::symbols). A declaration lowered again after a dependency already has them.
+// der(x[2]), … in the order derivativeVariable would make them, with their symbols made a batch at
+// a time (Context::symbols). A declaration lowered again after a dependency already has them.
 void Flattener::addCoordinateDerivatives(const Value& coordinates) {
   std::vector<int> vars;
   NameBuffer names;
+  auto make = [&] {
+    std::vector<Expr> symbols = ctx_.symbols(names.views());
+    for (size_t k = 0; k < vars.size(); ++k)
+      addDerivative(addDerivative(vars[k], VarRole::Velocity, symbols[2 * k]), VarRole::Acceleration, symbols[2 * k + 1]);
+    vars.clear();
+    names.clear();
+  };
   for (Expr x : coordinates.elems) {
     int var = out_.variableOf(x);
     if (out_.variables[var].derivative >= 0) continue;
@@ -206,10 +217,9 @@ void Flattener::addCoordinateDerivatives(const Value& coordinates) {
     names.finish();
     names.chars.append("der(der(").append(out_.variables[var].name) += "))";
     names.finish();
+    if (names.full()) make();
   }
-  std::vector<Expr> symbols = ctx_.symbols(names.views());
-  for (size_t k = 0; k < vars.size(); ++k)
-    addDerivative(addDerivative(vars[k], VarRole::Velocity, symbols[2 * k]), VarRole::Acceleration, symbols[2 * k + 1]);
+  make();
 }
 
 // A declaration's value, created on first use. Declarations may use each other in any order, and a
@@ -399,20 +409,25 @@ Value Flattener::variablesFor(const Declaration& d, const std::vector<int>& shap
   const Instance* top = cur_;
   while (top->parent && top->parent->parent) top = top->parent;
   SourceRange where = top->decl ? top->decl->nameRange : d.nameRange;
-  NameBuffer names;
-  forEachScalarName(cur_->prefix() + d.name, shape, [&](std::string_view name) {
-    names.chars += name;
-    names.finish();
-  });
   int attributes = 0;  // one record for the declaration's description, shared by its elements
   if (!d.description.empty()) {
     attributes = static_cast<int>(out_.attributes.size());
     out_.attributes.push_back({.description = d.description});
   }
-  for (Expr symbol : ctx_.symbols(names.views())) {
-    addVariable({.role = role, .symbol = symbol, .declRange = where, .attributes = attributes});
-    v.elems.push_back(symbol);
-  }
+  NameBuffer names;
+  auto make = [&] {
+    for (Expr symbol : ctx_.symbols(names.views())) {
+      addVariable({.role = role, .symbol = symbol, .declRange = where, .attributes = attributes});
+      v.elems.push_back(symbol);
+    }
+    names.clear();
+  };
+  forEachScalarName(cur_->prefix() + d.name, shape, [&](std::string_view name) {
+    names.chars += name;
+    names.finish();
+    if (names.full()) make();
+  });
+  make();
   slot.variables = std::move(v);
   slot.hasVariables = true;
   return slot.variables;
