@@ -135,7 +135,7 @@ class Builder {
     size_t states = std::count_if(kindOf.begin(), kindOf.end(), [](char k) { return k == Inertial || k == NotInertial; });
     firstKinematic_ = dae_.equations.size();  // appended in place (addEquations reserved room)
     kinematicPairs_.reserve(states);
-    std::vector<Expr> rates = rateSymbols(kindOf);
+    std::vector<Expr> rates = rateSymbols(kindOf, states);
     size_t state = 0;
     for (size_t r = 0; r < eom_.rows.size(); ++r) {
       if (kindOf[r] == Skip) continue;
@@ -168,19 +168,29 @@ class Builder {
   }
 
   // The symbols of the coordinates' rates `$der(q)`, of the states among them in row order: made
-  // in one batch (a large array's), with the ids one by one would give.
-  std::vector<Expr> rateSymbols(const std::vector<char>& kindOf) {
+  // in batches (Context::symbols; a large array's names are not all written out at once), with the
+  // ids one by one would give.
+  std::vector<Expr> rateSymbols(const std::vector<char>& kindOf, size_t states) {
+    constexpr size_t kBatch = 4096;
+    ctx_.reserve(states, 0);  // the name table grows once
+    std::vector<Expr> rates;
+    rates.reserve(states);
     std::string buffer;
     std::vector<size_t> ends;
+    auto make = [&] {
+      std::vector<std::string_view> names;
+      for (size_t k = 0, begin = 0; k < ends.size(); begin = ends[k++]) names.emplace_back(buffer.data() + begin, ends[k] - begin);
+      for (Expr s : ctx_.symbols(names)) rates.push_back(s);
+      buffer.clear(), ends.clear();
+    };
     for (size_t r = 0; r < eom_.rows.size(); ++r) {
       if (kindOf[r] != Inertial && kindOf[r] != NotInertial) continue;  // not a state
       buffer.append("$der(").append(m_.variables[eom_.rows[r].coordinate].name).append(")");
       ends.push_back(buffer.size());
+      if (ends.size() == kBatch) make();
     }
-    std::vector<std::string_view> names;
-    names.reserve(ends.size());
-    for (size_t k = 0, begin = 0; k < ends.size(); begin = ends[k++]) names.emplace_back(buffer.data() + begin, ends[k] - begin);
-    return ctx_.symbols(names);
+    make();
+    return rates;
   }
 
   // The kinematic rows q' - der(q) that no template took (templated models only).
