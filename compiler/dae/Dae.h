@@ -16,25 +16,43 @@
 
 namespace qdot::dae {
 
-enum class VarKind { State, Algebraic };
+enum class VarKind : uint8_t { State, Algebraic };
 /// What an unknown of the DAE is in the mechanics (what a declaration is: flat::VarRole).
-enum class UnknownRole { Coordinate, Velocity, State, Algebraic, Multiplier, Derivative };
+enum class UnknownRole : uint8_t { Coordinate, Velocity, State, Algebraic, Multiplier, Derivative };
 const char* roleName(UnknownRole r);
 
-/// An unknown of the DAE: what the DAE makes of it (kind, role, symbols, result name) and its
-/// declaration as the flat model has it (embedded, not copied field by field).
+/// What the later stages read of an unknown's declaration: where it is, its start value (over
+/// parameters; null = none) and nominal value, and whether the start is fixed. Not the whole
+/// flat::Variable: a large model has two unknowns per array element, and the rest of the
+/// declaration (name, symbol, role, description, unit, min, max) is either in the Variable or unused.
+struct Declaration {
+  SourceRange declRange;
+  bool fixed = false;
+  bool fixedGiven = false;  ///< `fixed` written by the user (flat::Variable::fixedGiven)
+  sym::Expr start = nullptr;
+  sym::Expr nominal = nullptr;
+
+  static Declaration of(const flat::FlatModel& m, int variable) {
+    const flat::Variable& f = m.variables[variable];
+    return {.declRange = f.declRange, .fixed = f.fixed, .fixedGiven = f.fixedGiven, .start = f.start,
+            .nominal = m.attributesOf(f).nominal};
+  }
+};
+
+/// An unknown of the DAE: what the DAE makes of it (kind, role, symbols, result name) and what it
+/// keeps of its declaration in the flat model.
 struct Variable {
   std::string name;  ///< result name: "x", "der(x)", "lambda[1]"
   VarKind kind = VarKind::Algebraic;
   UnknownRole role = UnknownRole::Algebraic;
-  sym::Expr y = nullptr;   ///< the variable's symbol (declaration.symbol)
-  sym::Expr yp = nullptr;  ///< its time-derivative symbol (states only)
   int flatVar = -1;        ///< index in the FlatModel (-1 for multipliers)
-  /// declRange, start (over parameters; null = none), fixed, nominal, description, unit. A
-  /// velocity without a declared start starts at 0; a multiplier's declaration is made by buildDae
-  /// (the constraint's range, role flat::VarRole::Multiplier).
-  flat::Variable declaration;
+  sym::Expr y = nullptr;   ///< the variable's symbol
+  sym::Expr yp = nullptr;  ///< its time-derivative symbol (states only)
+  /// A velocity without a declared start starts at 0; a multiplier's declaration is made by
+  /// buildDae (the constraint's range).
+  Declaration declaration;
 };
+static_assert(sizeof(Variable) <= 88, "dae::Variable: a large model has two per array element");
 
 /// A DAE equation is a flat equation (residual, origin, the sides as written).
 using Equation = flat::Equation;

@@ -57,7 +57,7 @@ class Builder {
   sym::Context& ctx_;
   DiagnosticEngine& diags_;
   Dae dae_;
-  std::vector<Equation> kinematic_;
+  size_t firstKinematic_ = 0;  ///< where addMechanics appended the kinematic rows
   enum RowKind : char { Skip, Algebraic, NotInertial, Inertial };  ///< of a coordinate's row, in addMechanics
   std::vector<char> kinematicTaken_;  ///< per kinematic row (templated models): a template's
   std::vector<std::pair<int, int>> kinematicPairs_;  ///< per kinematic row: coordinate, velocity (index among velocities)
@@ -104,16 +104,16 @@ class Builder {
 
   Variable fromFlat(int index, VarKind kind, UnknownRole role) {
     const flat::Variable& f = m_.variables[index];
-    return Variable{.name = std::string(f.name), .kind = kind, .role = role, .y = f.symbol, .flatVar = index,
-                    .declaration = f};
+    return Variable{.name = std::string(f.name), .kind = kind, .role = role, .flatVar = index, .y = f.symbol,
+                    .declaration = Declaration::of(m_, index)};
   }
 
   void addParameters() {
     for (const auto& f : m_.variables)
       if (f.role == flat::VarRole::Parameter)
         dae_.parameters.push_back(
-            {std::string(f.name), f.symbol, f.value, std::string(f.description), std::string(f.unit), f.declRange,
-             f.input});
+            {std::string(f.name), f.symbol, f.value, std::string(m_.attributesOf(f).description),
+             std::string(m_.attributesOf(f).unit), f.declRange, f.input});
   }
 
   // Coordinates first, then velocities (spec §5). A coordinate whose row contains no velocity at
@@ -133,9 +133,9 @@ class Builder {
       kindOf[r] = inertial ? Inertial : appears(v.symbol) ? NotInertial : Algebraic;
     }
     size_t states = std::count_if(kindOf.begin(), kindOf.end(), [](char k) { return k == Inertial || k == NotInertial; });
-    kinematic_.reserve(states);
+    firstKinematic_ = dae_.equations.size();  // appended in place (addEquations reserved room)
     kinematicPairs_.reserve(states);
-    std::vector<Expr> rates = rateSymbols(kindOf);
+    std::vector<Expr> rates = rateSymbols(kindOf, states);
     size_t state = 0;
     for (size_t r = 0; r < eom_.rows.size(); ++r) {
       if (kindOf[r] == Skip) continue;
@@ -149,7 +149,7 @@ class Builder {
       qv.yp = rates[state++];
       // A templated model's kinematic rows are made when addTemplateBlocks has taken its arrays'.
       Expr residual = eom_.templateRows.empty() ? ctx_.sub(qv.yp, m_.variables[q.derivative].symbol) : nullptr;
-      kinematic_.push_back({residual, {flat::OriginKind::Kinematic, q.declRange, eom_.rows[r].coordinate, ""}});
+      dae_.equations.push_back({residual, {flat::OriginKind::Kinematic, q.declRange, eom_.rows[r].coordinate, ""}});
       kinematicPairs_.push_back({static_cast<int>(dae_.variables.size()), static_cast<int>(kinematicPairs_.size())});
       dae_.variables.push_back(std::move(qv));
     }
@@ -168,19 +168,29 @@ class Builder {
   }
 
   // The symbols of the coordinates' rates `$der(q)`, of the states among them in row order: made
-  // in one batch (a large array's), with the ids one by one would give.
-  std::vector<Expr> rateSymbols(const std::vector<char>& kindOf) {
+  // in batches (Context::symbols; a large array's names are not all written out at once), with the
+  // ids one by one would give.
+  std::vector<Expr> rateSymbols(const std::vector<char>& kindOf, size_t states) {
+    constexpr size_t kBatch = 4096;
+    ctx_.reserve(states, 0);  // the name table grows once
+    std::vector<Expr> rates;
+    rates.reserve(states);
     std::string buffer;
     std::vector<size_t> ends;
+    auto make = [&] {
+      std::vector<std::string_view> names;
+      for (size_t k = 0, begin = 0; k < ends.size(); begin = ends[k++]) names.emplace_back(buffer.data() + begin, ends[k] - begin);
+      for (Expr s : ctx_.symbols(names)) rates.push_back(s);
+      buffer.clear(), ends.clear();
+    };
     for (size_t r = 0; r < eom_.rows.size(); ++r) {
       if (kindOf[r] != Inertial && kindOf[r] != NotInertial) continue;  // not a state
       buffer.append("$der(").append(m_.variables[eom_.rows[r].coordinate].name).append(")");
       ends.push_back(buffer.size());
+      if (ends.size() == kBatch) make();
     }
-    std::vector<std::string_view> names;
-    names.reserve(ends.size());
-    for (size_t k = 0, begin = 0; k < ends.size(); begin = ends[k++]) names.emplace_back(buffer.data() + begin, ends[k] - begin);
-    return ctx_.symbols(names);
+    make();
+    return rates;
   }
 
   // The kinematic rows q' - der(q) that no template took (templated models only).
@@ -209,11 +219,8 @@ class Builder {
                           std::make_move_iterator(algebraic.end()));
     for (const auto& mult : eom_.multipliers) {
       const auto& c = m_.constraints[mult.constraint];
-      flat::Variable declaration{.name = ctx_.symbolName(mult.symbol), .role = flat::VarRole::Multiplier,
-                                 .symbol = mult.symbol, .declRange = c.origin.range,
-                                 .description = "Lagrange multiplier of the constraint"};
       dae_.variables.push_back({.name = mult.name, .kind = VarKind::Algebraic, .role = UnknownRole::Multiplier,
-                                .y = mult.symbol, .declaration = declaration});
+                                .y = mult.symbol, .declaration = {.declRange = c.origin.range}});
     }
   }
 
@@ -298,10 +305,12 @@ class Builder {
   }
 
   // The kinematic rows go after the Euler–Lagrange rows (made by addMechanics, which needs to
-  // know which symbols the other equations contain).
+  // know which symbols the other equations contain, and appends them): rotated past the other
+  // equations, a few in most models, rather than copied from a temporary (a row per coordinate).
   void insertKinematicRows() {
-    dae_.equations.insert(dae_.equations.begin() + static_cast<long>(eom_.rows.size()),
-                          std::make_move_iterator(kinematic_.begin()), std::make_move_iterator(kinematic_.end()));
+    auto first = dae_.equations.begin();
+    std::rotate(first + static_cast<long>(eom_.rows.size()), first + static_cast<long>(firstKinematic_),
+                dae_.equations.end());
   }
 };
 

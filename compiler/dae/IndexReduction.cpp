@@ -68,13 +68,9 @@ class Reducer {
     v.yp = ctx_.symbol("$der(" + v.name + ")");
     Variable d{.name = name, .kind = VarKind::Algebraic, .role = UnknownRole::Derivative, .y = value};
     d.declaration = v.declaration;
-    d.declaration.name = ctx_.symbolName(value);  // a view the Context owns
-    d.declaration.symbol = value;
     d.declaration.start = nullptr;  // a guess of 0; initialization computes it
     d.declaration.fixed = false;
     d.declaration.nominal = nullptr;
-    d.declaration.description = "time derivative (index reduction)";
-    d.declaration.unit = {};
     flat::Origin origin{.kind = flat::OriginKind::Kinematic, .range = v.declaration.declRange, .variable = v.flatVar};
     Expr link = ctx_.sub(v.yp, value);
     int row = static_cast<int>(dae_.equations.size());

@@ -19,7 +19,7 @@ void printVariable(std::ostream& os, size_t i, const Variable& v, const sym::Con
   os << "  " << i << " " << v.name << ": " << kind;
   if (kind != roleName(v.role)) os << ", " << roleName(v.role);
   if (v.yp) os << ", derivative " << sym::toString(ctx, v.yp);
-  const flat::Variable& d = v.declaration;
+  const Declaration& d = v.declaration;
   if (d.start) os << ", start = " << sym::toString(ctx, d.start);
   if (d.fixed) os << ", fixed";
   if (d.nominal) os << ", nominal = " << sym::toString(ctx, d.nominal);

@@ -200,8 +200,9 @@ void addTemplatedOde(const flat::FlatModel& m, sym::Context& ctx, Dae& dae) {
     unknown[i] = static_cast<int>(dae.variables.size());
     bool state = f.derivative >= 0;
     dae.variables.push_back({.name = std::string(f.name), .kind = state ? VarKind::State : VarKind::Algebraic,
-                             .role = state ? UnknownRole::State : UnknownRole::Algebraic, .y = f.symbol,
-                             .yp = state ? m.variables[f.derivative].symbol : nullptr, .flatVar = i, .declaration = f});
+                             .role = state ? UnknownRole::State : UnknownRole::Algebraic, .flatVar = i, .y = f.symbol,
+                             .yp = state ? m.variables[f.derivative].symbol : nullptr,
+                             .declaration = Declaration::of(m, i)});
   }
   dae.equations.resize(dae.variables.size());
   std::vector<char> placed(dae.equations.size(), 0);

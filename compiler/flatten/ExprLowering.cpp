@@ -313,6 +313,8 @@ std::vector<Expr> Flattener::iterationValues(const ast::Expr& range) {
   // not convert to size_t.
   countScalars(static_cast<size_t>(std::min(count, static_cast<double>(limits_.maxScalars) + 1)), range.range);
   std::vector<Expr> out;
+  out.reserve(static_cast<size_t>(count));
+  ctx_.reserve(0, static_cast<size_t>(count));  // a large range's constants: the intern table grows once
   for (long i = 0; i < static_cast<long>(count); ++i) out.push_back(ctx_.constant(a + i * step));
   return out;
 }

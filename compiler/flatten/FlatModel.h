@@ -32,8 +32,17 @@ enum class VarRole : uint8_t {
 };
 const char* roleName(VarRole r);
 
-// A large model has three of these per array element (and the DAE keeps a copy per unknown), so
-// the two indices sit in what would be padding after the flags and after declRange: 128 bytes, not 136.
+/// What few variables have, kept beside them: a variable refers to a record (Variable::attributes),
+/// and the elements of an array share one as long as they are given the same values (its
+/// description, a unit or nominal written once for all).
+struct VariableAttributes {
+  std::string_view description;
+  std::string_view unit;
+  sym::Expr nominal = nullptr, min = nullptr, max = nullptr;
+};
+
+// A large model has three of these per array element (x, der(x), der(der(x))): what most of them
+// never have lives in VariableAttributes, and the indices and flags fill what would be padding.
 struct Variable {
   std::string_view name;  ///< user-facing scalar name: `th[1]`, `der(th[1])` (the symbol's name)
   VarRole role = VarRole::Unknown;
@@ -44,17 +53,15 @@ struct Variable {
   sym::Expr symbol = nullptr;
   SourceRange declRange;  ///< the declaration's name (or the der() that created it)
   int derivativeOf = -1;  ///< this is der(variables[derivativeOf])
-  std::string_view description;
-  std::string_view unit;
   sym::Expr start = nullptr;  ///< start attribute (over parameters); null if none
-  sym::Expr nominal = nullptr, min = nullptr, max = nullptr;
   sym::Expr value = nullptr;  ///< Parameter: default value (over other parameters)
   /// Not an unknown: equal to this expression (another variable, or one of parameters and time)
   /// through connections and alias equations (`a.s = s`, `a.s = s0`). The Euler–Lagrange rows are
   /// derived with the variable itself; the DAE substitutes the alias everywhere.
   sym::Expr alias = nullptr;
+  int attributes = 0;  ///< index in FlatModel::attributes (0: none)
 };
-static_assert(sizeof(Variable) <= 128, "flat::Variable: keep the indices in the padding (see above)");
+static_assert(sizeof(Variable) <= 80, "flat::Variable: a large model has three per array element (see above)");
 
 enum class OriginKind {
   Equation,         ///< a line of the equation section
@@ -212,6 +219,8 @@ struct FlatModel {
   SourceRange range;
   std::vector<Variable> variables;    ///< variables[kTime] is `time`
   std::vector<int> symbolToVariable;  ///< indexed by sym symbolId; -1 for non-variable symbols
+  /// Variable::attributes indexes these; [0] has none (the attributes of most variables).
+  std::vector<VariableAttributes> attributes = std::vector<VariableAttributes>(1);
   std::vector<Equation> equations;
   std::vector<Equation> initialEquations;
   std::vector<Term> kinetic, potential, dissipation;
@@ -247,6 +256,7 @@ struct FlatModel {
   int variableOf(sym::Expr s) const {
     return s->isSymbol() && s->symbolId < symbolToVariable.size() ? symbolToVariable[s->symbolId] : -1;
   }
+  const VariableAttributes& attributesOf(const Variable& v) const { return attributes[v.attributes]; }
   /// The relative element a symbol stands for, or nullptr.
   const RelativeElement* relativeElement(sym::Expr s) const { return patterns->find(s); }
   std::vector<int> variablesWithRole(VarRole r) const {

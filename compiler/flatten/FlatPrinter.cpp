@@ -14,15 +14,16 @@ std::string at(const SourceManager& sm, SourceRange r) {
   return line.empty() ? "" : "   (" + line + ")";
 }
 
-void printVariable(std::ostream& os, const Variable& v, const sym::Context& ctx, const SourceManager& sm) {
+void printVariable(std::ostream& os, const Variable& v, const VariableAttributes& a, const sym::Context& ctx,
+                   const SourceManager& sm) {
   os << "  " << v.name << ": " << roleName(v.role);
   if (v.value) os << " = " << sym::toString(ctx, v.value);
   if (v.start) os << ", start = " << sym::toString(ctx, v.start);
   if (v.fixed) os << ", fixed";
-  if (v.nominal) os << ", nominal = " << sym::toString(ctx, v.nominal);
-  if (v.min) os << ", min = " << sym::toString(ctx, v.min);
-  if (v.max) os << ", max = " << sym::toString(ctx, v.max);
-  if (!v.unit.empty()) os << ", unit \"" << v.unit << "\"";
+  if (a.nominal) os << ", nominal = " << sym::toString(ctx, a.nominal);
+  if (a.min) os << ", min = " << sym::toString(ctx, a.min);
+  if (a.max) os << ", max = " << sym::toString(ctx, a.max);
+  if (!a.unit.empty()) os << ", unit \"" << a.unit << "\"";
   if (v.alias) os << ", is " << sym::toString(ctx, v.alias);
   os << at(sm, v.declRange) << "\n";
 }
@@ -80,7 +81,7 @@ void printFlatModel(std::ostream& os, const FlatModel& m, const sym::Context& ct
   os << "flat model " << m.name;
   if (!m.description.empty()) os << " \"" << m.description << "\"";
   os << "\n\nvariables (" << m.variables.size() << "):\n";
-  for (const Variable& v : m.variables) printVariable(os, v, ctx, sm);
+  for (const Variable& v : m.variables) printVariable(os, v, m.attributesOf(v), ctx, sm);
   os << "\n";
   printTerms(os, "kinetic", m.kinetic, ctx, sm);
   printTerms(os, "potential", m.potential, ctx, sm);

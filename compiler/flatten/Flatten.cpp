@@ -42,12 +42,16 @@ static void forEachScalarName(const std::string& base, const std::vector<int>& s
 namespace {
 
 // Many names in one buffer instead of a string each; viewed once all are written (the buffer moves
-// while it grows).
+// while it grows). A large array's names go through it in batches (full(), then clear()): the
+// buffers stay small and in cache instead of growing to tens of bytes per element.
 struct NameBuffer {
+  static constexpr size_t kBatch = 4096;
   std::string chars;
   std::vector<size_t> ends;
   /// The characters appended since the previous name are a name.
   void finish() { ends.push_back(chars.size()); }
+  bool full() const { return ends.size() >= kBatch; }
+  void clear() { chars.clear(), ends.clear(); }
   std::vector<std::string_view> views() const {
     std::vector<std::string_view> out;
     out.reserve(ends.size());
@@ -193,11 +197,18 @@ int Flattener::addDerivative(int var, VarRole role, Expr symbol) {
 }
 
 // Every coordinate has a velocity and an acceleration, used or not: der(x[1]), der(der(x[1])),
-// der(x[2]), … in the order derivativeVariable would make them, with their symbols made at once
-// (Context::symbols). A declaration lowered again after a dependency already has them.
+// der(x[2]), … in the order derivativeVariable would make them, with their symbols made a batch at
+// a time (Context::symbols). A declaration lowered again after a dependency already has them.
 void Flattener::addCoordinateDerivatives(const Value& coordinates) {
   std::vector<int> vars;
   NameBuffer names;
+  auto make = [&] {
+    std::vector<Expr> symbols = ctx_.symbols(names.views());
+    for (size_t k = 0; k < vars.size(); ++k)
+      addDerivative(addDerivative(vars[k], VarRole::Velocity, symbols[2 * k]), VarRole::Acceleration, symbols[2 * k + 1]);
+    vars.clear();
+    names.clear();
+  };
   for (Expr x : coordinates.elems) {
     int var = out_.variableOf(x);
     if (out_.variables[var].derivative >= 0) continue;
@@ -206,10 +217,9 @@ void Flattener::addCoordinateDerivatives(const Value& coordinates) {
     names.finish();
     names.chars.append("der(der(").append(out_.variables[var].name) += "))";
     names.finish();
+    if (names.full()) make();
   }
-  std::vector<Expr> symbols = ctx_.symbols(names.views());
-  for (size_t k = 0; k < vars.size(); ++k)
-    addDerivative(addDerivative(vars[k], VarRole::Velocity, symbols[2 * k]), VarRole::Acceleration, symbols[2 * k + 1]);
+  make();
 }
 
 // A declaration's value, created on first use. Declarations may use each other in any order, and a
@@ -399,15 +409,25 @@ Value Flattener::variablesFor(const Declaration& d, const std::vector<int>& shap
   const Instance* top = cur_;
   while (top->parent && top->parent->parent) top = top->parent;
   SourceRange where = top->decl ? top->decl->nameRange : d.nameRange;
+  int attributes = 0;  // one record for the declaration's description, shared by its elements
+  if (!d.description.empty()) {
+    attributes = static_cast<int>(out_.attributes.size());
+    out_.attributes.push_back({.description = d.description});
+  }
   NameBuffer names;
+  auto make = [&] {
+    for (Expr symbol : ctx_.symbols(names.views())) {
+      addVariable({.role = role, .symbol = symbol, .declRange = where, .attributes = attributes});
+      v.elems.push_back(symbol);
+    }
+    names.clear();
+  };
   forEachScalarName(cur_->prefix() + d.name, shape, [&](std::string_view name) {
     names.chars += name;
     names.finish();
+    if (names.full()) make();
   });
-  for (Expr symbol : ctx_.symbols(names.views())) {
-    addVariable({.role = role, .symbol = symbol, .declRange = where, .description = d.description});
-    v.elems.push_back(symbol);
-  }
+  make();
   slot.variables = std::move(v);
   slot.hasVariables = true;
   return slot.variables;
@@ -460,7 +480,7 @@ void Flattener::applyAttributeList(const std::vector<ast::Modification>& mods, c
     if (!mod.value) continue;
     if (mod.name == "unit") {
       if (auto* s = dyn_cast<StringExpr>(mod.value.get()))
-        for (Expr x : vars.elems) out_.variables[out_.variableOf(x)].unit = s->value;
+        setAttribute(vars, true, [&](VariableAttributes& a, size_t) { a.unit = s->value; });
       continue;
     }
     if (mod.name != "start" && mod.name != "fixed" && mod.name != "nominal" && mod.name != "min" && mod.name != "max")
@@ -476,16 +496,42 @@ void Flattener::applyAttributeList(const std::vector<ast::Modification>& mods, c
       v = lower(*mod.value);
     }
     if (!v.isScalar()) checkShape(v, vars.shape, mod.value->range, "the " + mod.name + " value of '" + name + "'");
+    auto element = [&](size_t i) { return v.isScalar() ? v.elems[0] : v.elems[i]; };
+    if (mod.name == "nominal" || mod.name == "min" || mod.name == "max") {
+      Expr VariableAttributes::*field = mod.name == "nominal" ? &VariableAttributes::nominal
+                                        : mod.name == "min"   ? &VariableAttributes::min
+                                                              : &VariableAttributes::max;
+      setAttribute(vars, v.isScalar(), [&](VariableAttributes& a, size_t i) { a.*field = element(i); });
+      continue;
+    }
     for (size_t i = 0; i < vars.size(); ++i) {
       Variable& var = out_.variables[out_.variableOf(vars.elems[i])];
-      Expr x = v.isScalar() ? v.elems[0] : v.elems[i];
+      Expr x = element(i);
       if (mod.name == "start") var.start = x;
-      else if (mod.name == "nominal") var.nominal = x;
-      else if (mod.name == "min") var.min = x;
-      else if (mod.name == "max") var.max = x;
       else if (!x->isConstant()) fail(mod.value->range, DiagCode::E0303, "'fixed' must be true or false");
       else var.fixed = x->value != 0, var.fixedGiven = true;
     }
+  }
+}
+
+// set(attributes, i) on a copy of the record of element i of `vars`, which then refers to the copy.
+// With the same value for all (`sameForAll`), elements that shared a record share the new one.
+void Flattener::setAttribute(const Value& vars, bool sameForAll,
+                             const std::function<void(VariableAttributes&, size_t)>& set) {
+  std::unordered_map<int, int> copies;  // record before -> record after (sameForAll)
+  for (size_t i = 0; i < vars.size(); ++i) {
+    Variable& var = out_.variables[out_.variableOf(vars.elems[i])];
+    if (sameForAll)
+      if (auto it = copies.find(var.attributes); it != copies.end()) {
+        var.attributes = it->second;
+        continue;
+      }
+    VariableAttributes copy = out_.attributes[var.attributes];
+    set(copy, i);
+    int index = static_cast<int>(out_.attributes.size());
+    out_.attributes.push_back(copy);
+    if (sameForAll) copies.emplace(var.attributes, index);
+    var.attributes = index;
   }
 }
 

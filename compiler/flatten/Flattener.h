@@ -230,6 +230,7 @@ class Flattener {
   void applyAttributes(const ast::Declaration& d, const Value& vars);
   void applyAttributeList(const std::vector<ast::Modification>& mods, const std::string& name, const Value& vars,
                           const ModEntry* outer = nullptr);
+  void setAttribute(const Value& vars, bool sameForAll, const std::function<void(VariableAttributes&, size_t)>& set);
   Value bindingValue(const ast::Declaration& d, const std::vector<int>& shape);
   bool hasBinding(const ast::Declaration& d);
   void declareInstance(Instance& inst);

@@ -307,7 +307,7 @@ class Builder {
     starts.values.reserve(n);
     startUse_.reserve(n);
     for (size_t j = 0; j < n; ++j) {
-      const flat::Variable& d = dae_.variables[j].declaration;
+      const dae::Declaration& d = dae_.variables[j].declaration;
       starts.values.push_back(d.start);
       startUse_.push_back(d.fixedGiven ? (d.fixed ? dae::StartUse::Required : dae::StartUse::Guess)  // as written
                           : m_.description.fixed[j] ? dae::StartUse::Default

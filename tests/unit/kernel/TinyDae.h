@@ -22,10 +22,10 @@ struct TinyDae {
   TinyDae() {
     dae.name = "Tiny";
     dae.time = t;
-    dae.variables.push_back({.name = "x", .kind = dae::VarKind::State, .role = dae::UnknownRole::Coordinate, .y = x,
-                             .yp = dx, .flatVar = 1, .declaration = {.start = ctx.mul(ctx.constant(0.5), k)}});
-    dae.variables.push_back({.name = "der(x)", .kind = dae::VarKind::State, .role = dae::UnknownRole::Velocity,
-                             .y = v, .yp = a, .flatVar = 2, .declaration = {.start = ctx.zero()}});
+    dae.variables.push_back({.name = "x", .kind = dae::VarKind::State, .role = dae::UnknownRole::Coordinate, .flatVar = 1,
+                             .y = x, .yp = dx, .declaration = {.start = ctx.mul(ctx.constant(0.5), k)}});
+    dae.variables.push_back({.name = "der(x)", .kind = dae::VarKind::State, .role = dae::UnknownRole::Velocity, .flatVar = 2,
+                             .y = v, .yp = a, .declaration = {.start = ctx.zero()}});
     dae.parameters.push_back({.name = "k", .symbol = k, .value = ctx.mul(ctx.constant(2), m)});
     dae.parameters.push_back({.name = "m", .symbol = m, .value = ctx.constant(1.5)});
     dae.coordinates = {0};

@@ -156,6 +156,50 @@ TEST(Flatten, CycleThroughALongChainIsReportedWhereItCloses) {
             "cycle:" + std::to_string(kChainLinks + 4) + ":18: error[E0312]: the definition of 'a0' depends on itself");
 }
 
+// Descriptions, nominals, min and max (and units) live beside the variables (VariableAttributes): the
+// elements of an array given one value share one record, whatever the array's size; elements
+// given their own values get their own.
+TEST(Flatten, AttributesAreSharedByTheElementsGivenTheSameValues) {
+  CompiledModel m("attr", R"(
+model Attr
+  parameter Integer n = 50;
+  coordinate Real x[n](start = {0.1*i for i in 1:n}, nominal = 2) "positions";
+  Real y[2](nominal = {1, 5}, min = {0, -1}) "forces";
+mechanics
+  kinetic = sum(0.5*der(x[i])^2 for i in 1:n);
+  potential = sum(0.5*x[i]^2 for i in 1:n);
+equation
+  y[1] = x[1]^2;
+  y[2] = x[2]^2;
+end Attr;)");
+  ASSERT_TRUE(m.ok());
+  const flat::FlatModel& f = *m.compilation().flat;
+  auto variable = [&](const std::string& name) -> const flat::Variable& {
+    return f.variables.at(f.variableOf(m.compilation().ctx.findSymbol(name)));
+  };
+  const flat::Variable& x1 = variable("x[1]");
+  for (int i = 2; i <= 50; ++i) EXPECT_EQ(variable("x[" + std::to_string(i) + "]").attributes, x1.attributes);
+  const flat::VariableAttributes& xa = f.attributesOf(x1);
+  EXPECT_EQ(xa.description, "positions");
+  ASSERT_TRUE(xa.nominal && xa.nominal->isConstant());
+  EXPECT_EQ(xa.nominal->value, 2.0);
+  EXPECT_EQ(xa.min, nullptr);
+  EXPECT_EQ(variable("der(x[7])").attributes, 0);  // a derivative has none
+  EXPECT_LT(f.attributes.size(), 10u);             // not one per element
+  const flat::VariableAttributes &y1 = f.attributesOf(variable("y[1]")), &y2 = f.attributesOf(variable("y[2]"));
+  EXPECT_EQ(y1.description, "forces");
+  EXPECT_EQ(y2.description, "forces");
+  EXPECT_EQ(y1.nominal->value, 1.0);
+  EXPECT_EQ(y2.nominal->value, 5.0);
+  EXPECT_EQ(y1.min->value, 0.0);
+  EXPECT_EQ(y2.min->value, -1.0);
+  EXPECT_EQ(f.attributesOf(variable("x[3]")).nominal, xa.nominal);
+  // The DAE keeps the nominal value of each unknown.
+  for (const dae::Variable& v : m.dae().variables)
+    if (v.name == "y[2]") EXPECT_EQ(m.eval(v.declaration.nominal), 5.0);
+    else if (v.name == "x[3]") EXPECT_EQ(m.eval(v.declaration.nominal), 2.0);
+}
+
 TEST(Dae, ClassifiesStatesAlgebraicsAndMasslessCoordinates) {
   // q1 has inertia; q2 is a massless node between two springs (algebraic); q3 is a damped massless
   // coordinate (first order: q3 a state, its velocity algebraic); x is a state, y algebraic.
