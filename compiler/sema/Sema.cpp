@@ -380,7 +380,13 @@ class ClassChecker {
                    "attributes are start, fixed, min, max, nominal and unit");
       return;
     }
-    if (mod.value) checkExpr(*mod.value);
+    // unit, displayUnit and quantity are texts (spec: `unit = "m"`); every other attribute a value.
+    bool text = mod.name == "unit" || mod.name == "displayUnit" || mod.name == "quantity";
+    if (!mod.value) return;
+    if (!text) return checkExpr(*mod.value);
+    if (mod.value->kind != ExprKind::String)
+      diags_.error(mod.value->range, DiagCode::E0225, "'" + mod.name + "' of '" + d.name + "' takes a string",
+                   "write it in quotes, e.g. " + mod.name + " = \"m\"");
   }
 
   // Array sizes must be Integer expressions of literals, Integer parameters and constants.

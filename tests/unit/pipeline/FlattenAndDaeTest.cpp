@@ -163,7 +163,7 @@ TEST(Flatten, AttributesAreSharedByTheElementsGivenTheSameValues) {
   CompiledModel m("attr", R"(
 model Attr
   parameter Integer n = 50;
-  coordinate Real x[n](start = {0.1*i for i in 1:n}, nominal = 2) "positions";
+  coordinate Real x[n](start = {0.1*i for i in 1:n}, nominal = 2, unit = "m") "positions";
   Real y[2](nominal = {1, 5}, min = {0, -1}) "forces";
 mechanics
   kinetic = sum(0.5*der(x[i])^2 for i in 1:n);
@@ -181,6 +181,7 @@ end Attr;)");
   for (int i = 2; i <= 50; ++i) EXPECT_EQ(variable("x[" + std::to_string(i) + "]").attributes, x1.attributes);
   const flat::VariableAttributes& xa = f.attributesOf(x1);
   EXPECT_EQ(xa.description, "positions");
+  EXPECT_EQ(xa.unit, "m");  // a string attribute (sema once refused it: E0213)
   ASSERT_TRUE(xa.nominal && xa.nominal->isConstant());
   EXPECT_EQ(xa.nominal->value, 2.0);
   EXPECT_EQ(xa.min, nullptr);
