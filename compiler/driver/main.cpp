@@ -79,8 +79,10 @@ std::optional<ExitCode> compileToKernels(driver::Compilation& c, Options& o) {
 // --emit=STAGE: compile up to the stage, print its output, stop.
 ExitCode emitStage(driver::Compilation& c, Options& o) {
   driver::EmitStage stage = *driver::parseEmitStage(o.emit);
-  // What `qdot run` compiles, loops included, where the stage shown is past the DAE.
+  // What `qdot run` compiles, loops included, where the stage shown is past the DAE; with
+  // --invariants, as scalars (the kernels have no reductions), as the run would.
   c.options.keepLoops = driver::stageNeeded(stage) >= driver::Stage::Kernel;
+  c.options.keepInvariants = o.run.invariants;
   ExitCode failure;
   bool ok = compileTo(c, o, driver::stageNeeded(stage), failure) && driver::emit(c, stage, std::cout);
   if (!ok && failure == ExitCode::Usage) return failure;

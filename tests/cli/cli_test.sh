@@ -147,6 +147,10 @@ contains rows-count "would write 10000000001 rows" "$qdot" run "$src/examples/te
 check max-steps 3 "$qdot" run "$src/examples/textbook/utube.qd" --max-steps 50
 contains max-steps-message "reached --max-steps 50" "$qdot" run "$src/examples/textbook/utube.qd" --max-steps 50
 contains max-steps-rows "rows up to t =" "$qdot" run "$src/examples/textbook/utube.qd" --max-steps 50
+# --emit shows what the run compiles: the rod's `for` equation as one loop, scalar rows with
+# --invariants (the kernels have no reductions, so such a run keeps every stage scalar).
+contains emit-kernel-loop "equations of elements" "$qdot" run "$src/examples/heat/rod.qd" --emit=kernel
+check emit-kernel-invariants-scalar 1 sh -c "'$qdot' run '$src/examples/heat/rod.qd' --emit=kernel --invariants | grep -q 'equations of elements'"
 rm -f /tmp/qdot_cli_out.$$
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
