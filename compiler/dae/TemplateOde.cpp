@@ -110,10 +110,11 @@ class OdeCheck {
   // The unknown of the first element of the array a template row is matched to, or -1. The row
   // reads arrays of unknowns and of parameters (ldpl) by the template's iterators in order.
   int templateRow(const flat::EquationTemplate& t) {
-    const flat::ArrayVariable* own = ownArray(t);
+    RowSymbols s = rowSymbols(m_, ctx_, {t.lhs, t.rhs});
+    const flat::ArrayVariable* own = ownArray(s, t.box.size());
     if (!own) return -1;
     int first = unknownOfElement(own->elements[0]);
-    for (Expr other : rowSymbols(m_, ctx_, {t.lhs, t.rhs}).others) {
+    for (Expr other : s.others) {
       if (const flat::RelativeElement* rel = m_.relativeElement(other)) {
         if (flat::loopableParameters(m_, *rel, t.box.size(), own->shape)) continue;
         const flat::ArrayVariable& a = m_.patterns->arrays[rel->array];
@@ -130,7 +131,9 @@ class OdeCheck {
   // The array whose elements' rows a template gives (of derivatives or of algebraic unknowns),
   // consecutive unknowns, or null.
   const flat::ArrayVariable* ownArray(const flat::EquationTemplate& t) {
-    RowSymbols s = rowSymbols(m_, ctx_, {t.lhs, t.rhs});
+    return ownArray(rowSymbols(m_, ctx_, {t.lhs, t.rhs}), t.box.size());
+  }
+  const flat::ArrayVariable* ownArray(const RowSymbols& s, size_t iterators) {
     const flat::RelativeElement* own = nullptr;
     if (s.rates.size() == 1) {
       own = m_.relativeElement(s.rates[0]);
@@ -142,7 +145,7 @@ class OdeCheck {
         own = rel;
       }
     }
-    if (!own || !ownElement(*own, t.box.size())) return nullptr;
+    if (!own || !ownElement(*own, iterators)) return nullptr;
     const flat::ArrayVariable& a = m_.patterns->arrays[own->array];
     return firstOfConsecutive(a, [&](Expr e) { return unknownOfElement(e); }) >= 0 ? &a : nullptr;
   }

@@ -22,6 +22,16 @@ class LoopLowering : public ::testing::Test {
        i = ctx.symbol("i");
   Expr c(double v) { return ctx.constant(v); }
 
+  // out[L] = 2 * (load `op` at base + L) for L = first, first+1, ... (count iterations), 4 outputs.
+  kernel::Program doubledInLoop(Op op, uint32_t base, uint32_t count, int32_t first) {
+    kernel::ProgramBuilder b("residual");
+    b.bindLoopedLoad(here, op, base);
+    b.beginLoop(kernel::Loop{.count = count, .first = first, .stride = 1});
+    b.storeLooped(0, b.lower(ctx.mul(c(2), here)));
+    b.endLoop();
+    return b.finish(4);
+  }
+
   static size_t count(const kernel::Program& p, Op op) {
     size_t n = 0;
     for (const auto& ins : p.code) n += ins.op == op;
@@ -106,14 +116,7 @@ TEST_F(LoopLowering, CountZeroAndOne) {
 // checkLoops (what the JIT relies on) accepts the builder's loops and names each broken rule;
 // executedInstructions counts a body once per iteration.
 TEST_F(LoopLowering, CheckLoopsAndExecutedInstructions) {
-  auto build = [&](uint32_t count, int32_t first) {
-    kernel::ProgramBuilder b("residual");
-    b.bindLoopedLoad(here, Op::LoadYLooped, 1);
-    b.beginLoop(kernel::Loop{.count = count, .first = first, .stride = 1});
-    b.storeLooped(0, b.lower(ctx.mul(c(2), here)));
-    b.endLoop();
-    return b.finish(4);
-  };
+  auto build = [&](uint32_t count, int32_t first) { return doubledInLoop(Op::LoadYLooped, 1, count, first); };
   kernel::Program p = build(3, 0);  // y[1 + L], L = 0..2: y[1..3]; out[0..2]
   EXPECT_EQ(kernel::checkLoops(p, 4, 0), "");
   EXPECT_EQ(kernel::executedInstructions(p), 2 + 3u * 4);  // loop, endloop; 3 x (ldk, ldyl, mul, stl)
@@ -135,14 +138,7 @@ TEST_F(LoopLowering, CheckLoopsAndExecutedInstructions) {
 // A parameter array read in a loop (ldpl p[imm + L]) is checked against the parameters' count at
 // the loop's smallest and largest offsets, and only inside a loop.
 TEST_F(LoopLowering, CheckLoopsBoundsALoopedParameterLoad) {
-  auto build = [&](uint32_t count, int32_t first) {
-    kernel::ProgramBuilder b("residual");
-    b.bindLoopedLoad(here, Op::LoadPLooped, 2);
-    b.beginLoop(kernel::Loop{.count = count, .first = first, .stride = 1});
-    b.storeLooped(0, b.lower(ctx.mul(c(2), here)));
-    b.endLoop();
-    return b.finish(4);
-  };
+  auto build = [&](uint32_t count, int32_t first) { return doubledInLoop(Op::LoadPLooped, 2, count, first); };
   kernel::Program p = build(3, 0);  // p[2 + L], L = 0..2: p[2..4]
   ASSERT_EQ(count(p, Op::LoadPLooped), 1u);
   EXPECT_EQ(kernel::checkLoops(p, 4, 5), "");
