@@ -56,6 +56,10 @@ struct CompileOptions {
   /// Keep repeated structure as templates and loops where the model allows it (docs/loops.md):
   /// `qdot run`. Elsewhere (equations, modes, …) every sum is expanded.
   bool keepLoops = false;
+  /// Solve the algebraic unknowns some row defines explicitly out of the DAE (they become outputs,
+  /// still result columns: dae/ExplicitAlgebraics.h): what `qdot run` and `qdot build` integrate.
+  /// `qdot equations`, modes and linearize show and use the system as derived.
+  bool eliminateAlgebraics = false;
   /// Free each stage's input once the next stage has what it needs (`qdot run`: after the kernels
   /// only the kernels, the bytecode and the experiment are used): the flat model and the
   /// equations of motion once the DAE is built, the DAE and every symbolic node once the kernels

@@ -82,6 +82,7 @@ ExitCode emitStage(driver::Compilation& c, Options& o) {
   // What `qdot run` compiles, loops included, where the stage shown is past the DAE; with
   // --invariants, as scalars (the kernels have no reductions), as the run would.
   c.options.keepLoops = driver::stageNeeded(stage) >= driver::Stage::Kernel;
+  c.options.eliminateAlgebraics = c.options.keepLoops;
   c.options.keepInvariants = o.run.invariants;
   ExitCode failure;
   bool ok = compileTo(c, o, driver::stageNeeded(stage), failure) && driver::emit(c, stage, std::cout);
@@ -154,6 +155,7 @@ ExitCode run(driver::Compilation& c, Options& o) {
   c.options.results = o.run.outputs;
   c.options.keepInvariants = o.run.invariants;
   c.options.keepLoops = true;
+  c.options.eliminateAlgebraics = true;
   c.options.releaseStages = true;
   if (std::optional<ExitCode> failed = compileToKernels(c, o)) return *failed;
   driver::RunnableModel m = driver::makeRunnableModel(c, backendOf(o), o.run.invariants);
@@ -179,6 +181,7 @@ ExitCode run(driver::Compilation& c, Options& o) {
 
 ExitCode build(driver::Compilation& c, Options& o) {
   c.options.results = o.results;
+  c.options.eliminateAlgebraics = true;  // the system `qdot run` integrates
   if (std::string why = driver::checkOutputPath(o.exe.outputPath); !why.empty()) {
     std::cerr << "qdot: error: cannot write the executable: " << why << "\n";
     return ExitCode::Usage;

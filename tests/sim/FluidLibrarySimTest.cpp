@@ -53,8 +53,10 @@ long statistic(const RunResult& r, const std::string& name) {
 // √h by ∫ (δ/(ρ g s²))²/4 ds ≤ (δ/ρg)²/(12 h^(3/2)) and h by (δ/ρg)²/(6 h): 1.7e-6 m at h = 1 mm
 // (we allow 1.5 times that). The tank's throttle acts only below hDry = 0.1 mm: no error here.
 // Past empty: the level decays to zero and stays within [−1e-6, hDry] from t_e + 2 s to the end
-// (80 s, 1.8 t_e); the run takes at most 200 steps (72 measured; chattering at the empty tank
-// would take thousands).
+// (80 s, 1.8 t_e); the run takes at most 500 steps (236 measured; chattering at the empty tank
+// would take thousands). It took 72 while the port's pressure and flows were unknowns of the
+// system: the pressure's nominal 1e5 then set the scale of h's absolute tolerance as well (100 m,
+// one kind of unknown); `qdot run` now solves them out (dae/ExplicitAlgebraics.h) and h has its own.
 TEST(FluidLibrary, TorricelliDrainsToEmptyAndStays) {
   auto r = runExample("torricelli");
   expectGrid(r, 0, 80, 0.1);
@@ -84,7 +86,7 @@ TEST(FluidLibrary, TorricelliDrainsToEmptyAndStays) {
       EXPECT_LE(h[i], hDry) << "not empty at t = " << t[i];
     }
   }
-  EXPECT_LE(statistic(r, "steps"), 200);
+  EXPECT_LE(statistic(r, "steps"), 500);
   std::cout << "[measured] steps " << statistic(r, "steps") << ", error-test failures "
             << statistic(r, "error-test failures") << ", lowest level " << *std::min_element(h.begin(), h.end())
             << " m\n";
@@ -96,7 +98,7 @@ TEST(FluidLibrary, TorricelliAtDefaultToleranceRunsPastEmpty) {
   const auto& h = r.col("tank.h");
   EXPECT_GE(*std::min_element(h.begin(), h.end()), -1e-4);
   EXPECT_LE(h.back(), 1e-4);
-  EXPECT_LE(statistic(r, "steps"), 200);
+  EXPECT_LE(statistic(r, "steps"), 500);
 }
 
 // ---------------------------------------------------------------------------------------------
