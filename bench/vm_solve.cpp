@@ -37,6 +37,7 @@ struct Compiled {
 
 Compiled compile(const std::string& file, const std::string& backend, bool invariants) {
   driver::Compilation c;
+  c.options.eliminateAlgebraics = true;  // the system qdot run integrates (dae/ExplicitAlgebraics.h)
   if (!driver::compileFile(c, file, "", driver::Stage::Kernel)) {
     c.diags.render(std::cerr, c.sources);
     throw std::runtime_error("the model has errors");

@@ -62,7 +62,8 @@ void checkBytecode(const bc::Module& m) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   driver::Compilation c;
   c.options.limits.maxScalars = 20'000;  // keep each input fast; the limit itself is E0310
-  c.options.keepLoops = size % 2 == 0;    // half the inputs the way `qdot run` compiles: templates and loops
+  c.options.keepLoops = size % 2 == 0;    // half the inputs the way `qdot run` compiles: templates and loops,
+  c.options.eliminateAlgebraics = c.options.keepLoops;  // explicit algebraic unknowns solved out
   bool ok = driver::compileSource(c, "fuzz.qd", std::string(reinterpret_cast<const char*>(data), size), "",
                                   driver::Stage::Dae);
   checkDiagnostics(c, size);
