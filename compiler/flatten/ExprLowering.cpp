@@ -302,21 +302,124 @@ std::vector<Expr> Flattener::iterationValues(const ast::Expr& range) {
     if (v.shape.size() != 1) fail(range.range, DiagCode::E0308, "a loop range must be a vector, e.g. 1:n");
     return {v.elems.begin(), v.elems.end()};
   }
-  if (!r->start || !r->stop) fail(range.range, DiagCode::E0308, "a loop range needs a start and a stop, e.g. 1:n");
-  double a = lowerConstant(*r->start, "a range bound");
-  double step = r->step ? lowerConstant(*r->step, "a range step") : 1.0;
-  double b = lowerConstant(*r->stop, "a range bound");
-  if (step == 0) fail(r->step->range, DiagCode::E0308, "a range step cannot be 0");
+  RangeBounds b = rangeBounds(*r);
+  std::vector<Expr> out;
+  out.reserve(b.count);
+  ctx_.reserve(0, b.count);  // a large range's constants: the intern table grows once
+  for (long i = 0; i < static_cast<long>(b.count); ++i) out.push_back(ctx_.constant(b.first + i * b.step));
+  return out;
+}
+
+Flattener::RangeBounds Flattener::rangeBounds(const RangeExpr& r) {
+  if (!r.start || !r.stop) fail(r.range, DiagCode::E0308, "a loop range needs a start and a stop, e.g. 1:n");
+  double a = lowerConstant(*r.start, "a range bound");
+  double step = r.step ? lowerConstant(*r.step, "a range step") : 1.0;
+  double b = lowerConstant(*r.stop, "a range bound");
+  if (step == 0) fail(r.step->range, DiagCode::E0308, "a range step cannot be 0");
   double count = std::floor((b - a) / step + 1e-9) + 1;
-  if (!(count > 0)) return {};
+  if (!(count > 0)) return {a, step, 0};
   // Clamped to one past the limit, which countScalars refuses (E0310): a count like 1e300 does
   // not convert to size_t.
-  countScalars(static_cast<size_t>(std::min(count, static_cast<double>(limits_.maxScalars) + 1)), range.range);
-  std::vector<Expr> out;
-  out.reserve(static_cast<size_t>(count));
-  ctx_.reserve(0, static_cast<size_t>(count));  // a large range's constants: the intern table grows once
-  for (long i = 0; i < static_cast<long>(count); ++i) out.push_back(ctx_.constant(a + i * step));
-  return out;
+  countScalars(static_cast<size_t>(std::min(count, static_cast<double>(limits_.maxScalars) + 1)), r.range);
+  return {a, step, static_cast<size_t>(count)};
+}
+
+namespace {
+
+// A comprehension body made of numbers and the comprehension's own iterators under + − · / ^ and
+// a sign, e.g. the start values {0.01*i for i in 1:n}: the index of each name among `iterators`.
+bool isNumericBody(const ast::Expr& e, const std::vector<Iterator>& iterators) {
+  switch (e.kind) {
+    case ExprKind::Number: return true;
+    case ExprKind::Name: {
+      auto& parts = cast<NameExpr>(&e)->parts;
+      return parts.size() == 1 && std::any_of(iterators.begin(), iterators.end(),
+                                              [&](const Iterator& it) { return it.name == parts[0]; });
+    }
+    case ExprKind::Unary: {
+      auto* u = cast<UnaryExpr>(&e);
+      return u->op != UnaryOp::Not && isNumericBody(*u->operand, iterators);
+    }
+    case ExprKind::Binary: {
+      auto* b = cast<BinaryExpr>(&e);
+      bool arithmetic = b->op == BinaryOp::Add || b->op == BinaryOp::Sub || b->op == BinaryOp::Mul ||
+                        b->op == BinaryOp::Div || b->op == BinaryOp::Pow;
+      return arithmetic && isNumericBody(*b->lhs, iterators) && isNumericBody(*b->rhs, iterators);
+    }
+    default: return false;
+  }
+}
+
+// What a symbolic constant holds: −0 is 0 and every NaN one NaN (sym::Context::constant).
+double asConstant(double v) { return v == 0.0 ? 0.0 : std::isnan(v) ? std::numeric_limits<double>::quiet_NaN() : v; }
+
+// The body at iterator values `at` (by position in `iterators`, the innermost of a name winning),
+// folded exactly as the symbolic constructors fold constants (symbolic/Arith.cpp): a + b, a − b
+// (0 if the same constant), a·b, a·(1/b) and powValue, with each intermediate a constant.
+double foldNumeric(const ast::Expr& e, const std::vector<Iterator>& iterators, const std::vector<double>& at) {
+  switch (e.kind) {
+    case ExprKind::Number: return asConstant(cast<NumberExpr>(&e)->value);
+    case ExprKind::Name: {
+      const std::string& name = cast<NameExpr>(&e)->parts[0];
+      for (size_t k = iterators.size(); k-- > 0;)
+        if (iterators[k].name == name) return at[k];
+      break;
+    }
+    case ExprKind::Unary: {
+      auto* u = cast<UnaryExpr>(&e);
+      double v = foldNumeric(*u->operand, iterators, at);
+      return u->op == UnaryOp::Neg ? asConstant(-1.0 * v) : v;
+    }
+    case ExprKind::Binary: {
+      auto* b = cast<BinaryExpr>(&e);
+      double x = foldNumeric(*b->lhs, iterators, at), y = foldNumeric(*b->rhs, iterators, at);
+      auto same = [](double p, double q) { return p == q || (std::isnan(p) && std::isnan(q)); };
+      switch (b->op) {
+        case BinaryOp::Add: return x == 0 ? y : y == 0 ? x : asConstant(x + y);
+        case BinaryOp::Sub: return y == 0 ? x : same(x, y) ? 0.0 : asConstant(x - y);
+        case BinaryOp::Mul: return x == 1 ? y : y == 1 ? x : asConstant(x * y);
+        case BinaryOp::Div: return y == 1 ? x : asConstant(x * asConstant(1.0 / y));
+        case BinaryOp::Pow: return asConstant(sym::powValue(x, y));
+        default: break;
+      }
+      break;
+    }
+    default: break;
+  }
+  QDOT_UNREACHABLE("foldNumeric: isNumericBody admits only these");
+}
+
+}  // namespace
+
+// The elements of a numeric comprehension (isNumericBody over ranges) as constants, without a
+// symbolic constant per iterator value and per intermediate result: the start values of a
+// 10⁶-element array made 2·10⁶ constants, most of the time of flattening it. The same values as
+// lowering the body per element (foldNumeric), the same checks and counts; nullopt otherwise.
+std::optional<Value> Flattener::numericComprehension(const ComprehensionExpr& e) {
+  if (!isNumericBody(*e.body, e.iterators)) return std::nullopt;
+  for (const auto& it : e.iterators)
+    if (!dyn_cast<RangeExpr>(it.range.get())) return std::nullopt;
+  std::vector<RangeBounds> ranges;
+  Value v;
+  size_t count = 1;
+  for (const auto& it : e.iterators) {
+    ranges.push_back(rangeBounds(*cast<RangeExpr>(it.range.get())));
+    v.shape.push_back(static_cast<int>(ranges.back().count));
+    count *= ranges.back().count;
+  }
+  v.elems.reserve(count);
+  ctx_.reserve(0, count);
+  std::vector<double> at(ranges.size());
+  auto walk = [&](auto& self, size_t k) -> void {
+    if (k == ranges.size()) return v.elems.push_back(ctx_.constant(foldNumeric(*e.body, e.iterators, at)));
+    countScalars(ranges[k].count, e.iterators[k].range->range);  // as for a loop
+    for (size_t i = 0; i < ranges[k].count; ++i) {
+      at[k] = asConstant(ranges[k].first + static_cast<long>(i) * ranges[k].step);
+      self(self, k + 1);
+    }
+  };
+  walk(walk, 0);
+  return v;
 }
 
 Value Flattener::stack(std::vector<Value> parts, SourceRange r) {
@@ -342,6 +445,7 @@ Value Flattener::lowerArray(const ArrayExpr& e) {
 // once and the elements go straight into one list: a comprehension over a large array (the start
 // values of x[n]) makes no Value per element. Checked as stack() checks array literals.
 Value Flattener::lowerComprehension(const ComprehensionExpr& e) {
+  if (std::optional<Value> numbers = numericComprehension(e)) return std::move(*numbers);
   std::vector<std::vector<Expr>> ranges;
   Value v;
   size_t count = 1;

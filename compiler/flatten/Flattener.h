@@ -187,6 +187,12 @@ class Flattener {
   double lowerConstant(const ast::Expr& e, const char* what);
   long integerValue(double v, SourceRange r, const char* what);
   std::vector<sym::Expr> iterationValues(const ast::Expr& range);
+  /// A range's first value, step and number of values (checked as every range is).
+  struct RangeBounds {
+    double first = 0, step = 1;
+    size_t count = 0;
+  };
+  RangeBounds rangeBounds(const ast::RangeExpr& r);
   sym::Expr timeDerivative(sym::Expr e, SourceRange where);
   sym::Expr rateOf(sym::Expr symbol);
   Value eulerZXZ(const ast::CallExpr& e);
@@ -315,6 +321,7 @@ class Flattener {
   Value lowerArrayBuiltin(const std::string& name, const ast::CallExpr& e);
   Value lowerArray(const ast::ArrayExpr& e);
   Value lowerComprehension(const ast::ComprehensionExpr& e);
+  std::optional<Value> numericComprehension(const ast::ComprehensionExpr& e);
   Value lowerIf(const ast::IfExpr& e);
   Value lowerRange(const ast::RangeExpr& e);
   Value stack(std::vector<Value> parts, SourceRange r);

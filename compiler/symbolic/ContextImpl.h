@@ -61,8 +61,6 @@ inline bool isIntegerValue(double v) { return std::isfinite(v) && std::floor(v) 
 /// Applies a non-arithmetic kind (Pow, functions, comparisons, logic, select) to numbers.
 /// Shared by constant folding and evaluation so both agree bit for bit.
 double applyKind(Kind k, double a, double b = 0.0, double c = 0.0);
-/// base^exponent with exact fast paths (x^1, x^2, x^-1, x^0.5).
-double powValue(double base, double exponent);
 
 // --- traversal ------------------------------------------------------------------------------------
 

@@ -223,6 +223,10 @@ class PartialDerivatives {
 /// min/max are fmin/fmax. Iterative: cost is the DAG size, any depth is fine.
 double evaluate(Expr e, std::span<const double> values);
 
+/// base^exponent as constants are folded and expressions evaluated, with exact fast paths (x^1,
+/// x^2, x^-1, x^0.5): for a caller that folds numbers itself and must agree bit for bit.
+double powValue(double base, double exponent);
+
 /// Evaluates many roots sharing one memo (each node computed once).
 void evaluate(std::span<const Expr> roots, std::span<const double> values, std::span<double> out);
 

@@ -30,8 +30,15 @@ Expr Context::substitute(Expr e, const std::unordered_map<Expr, Expr>& map, uint
       result[i] = n;
     } else {
       kids.clear();
-      for (size_t c = 0; c < childCount(n); ++c) kids.push_back(result[*po.index.find(child(n, c))]);
-      result[i] = impl_->rebuild(n, kids);
+      bool changed = false;
+      for (size_t c = 0; c < childCount(n); ++c) {
+        kids.push_back(result[*po.index.find(child(n, c))]);
+        changed |= kids.back() != child(n, c);
+      }
+      // A node whose mask only seemed to meet the keys' (64 bits for all symbols: with many keys
+      // every node does) is itself; rebuilding it would find the same node, at the cost of
+      // canonicalising it again.
+      result[i] = changed ? impl_->rebuild(n, kids) : n;
     }
   }
   return result.back();

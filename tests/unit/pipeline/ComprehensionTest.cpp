@@ -1,6 +1,8 @@
 // Array comprehensions as flattening expands them: with two iterators the first is the first
 // dimension, elements that are arrays add their shape after the iterators', and elements of
 // different shapes are an error at the comprehension (as for an array literal).
+#include <bit>
+#include <cstdint>
 #include <sstream>
 #include <string>
 
@@ -58,6 +60,38 @@ end Shapes;)", "", driver::Stage::Dae));
   LineCol at = c.sources.lineCol(d.range.file, d.range.begin);
   EXPECT_EQ(at.line, 4u);
   EXPECT_EQ(at.col, 7u);
+}
+
+// The start values of x[n, m] from {body for i in 1:n, j in 1:m}, as numbers (flatten folds a
+// numeric body without symbolic intermediates).
+std::vector<double> startValues(const std::string& body) {
+  driver::Compilation c;
+  std::string text = "model S\n  coordinate Real x[7, 5](start = {" + body +
+                     " for i in 1:7, j in 1:5});\nmechanics\n  kinetic = sum(der(x[i, j])^2 for i in 1:7, j in 1:5);\nend S;\n";
+  EXPECT_TRUE(driver::compileSource(c, "start.qd", text, "", driver::Stage::Flatten)) << text;
+  std::vector<double> values;
+  if (!c.flat) return values;
+  for (const auto& v : c.flat->variables)
+    if (v.role == flat::VarRole::Coordinate && v.start) values.push_back(v.start->value);
+  return values;
+}
+
+// Reference: the same body lowered symbolically, element by element (adding sin(0), which folds
+// to the constant 0, keeps the value and takes the body out of the numeric path): the values must
+// be the same bit for bit, non-finite ones included.
+TEST(Comprehension, ANumericBodyGivesTheValuesOfItsSymbolicLowering) {
+  for (const char* body : {"0.01*i", "i/3 - j/7", "1/(i - 2)", "(i - 2)/(i - 2)", "-(i - 0.3*j)^2/7 + i*0.1",
+                           "2^(i/3) - j", "i*0.1 - 0.3", "+i - -j", "(1e308*i)*(1e10*j)", "i - i + 0.5/j"}) {
+    std::vector<double> numeric = startValues(body);
+    std::vector<double> symbolic = startValues(std::string("(") + body + ") + sin(0)");
+    ASSERT_EQ(numeric.size(), 35u) << body;
+    ASSERT_EQ(symbolic.size(), 35u) << body;
+    for (size_t k = 0; k < numeric.size(); ++k) {
+      if (std::isnan(numeric[k]) && std::isnan(symbolic[k])) continue;
+      EXPECT_EQ(std::bit_cast<uint64_t>(numeric[k]), std::bit_cast<uint64_t>(symbolic[k]))
+          << body << ", element " << k << ": " << numeric[k] << " against " << symbolic[k];
+    }
+  }
 }
 
 }  // namespace
