@@ -57,7 +57,7 @@ struct CompileOptions {
   /// `qdot run`. Elsewhere (equations, modes, …) every sum is expanded.
   bool keepLoops = false;
   /// Solve the algebraic unknowns some row defines explicitly out of the DAE (they become outputs,
-  /// still result columns: dae/ExplicitAlgebraics.h): what `qdot run` and `qdot build` integrate.
+  /// still result columns: dae/ExplicitAlgebraics.h): what `qdot run`, `build` and `wp` integrate.
   /// `qdot equations`, modes and linearize show and use the system as derived.
   bool eliminateAlgebraics = false;
   /// Free each stage's input once the next stage has what it needs (`qdot run`: after the kernels

@@ -233,6 +233,7 @@ ExitCode linearize(driver::Compilation& c, Options& o) {
 // takes the structural (Integer) assignments out of it.
 ExitCode workPrecision(driver::Compilation& c, Options& o) {
   o.run.parameters = o.wp.run.parameters;
+  c.options.eliminateAlgebraics = true;  // the system `qdot run` integrates
   if (std::optional<ExitCode> failed = compileToKernels(c, o)) return *failed;
   c.diags.render(std::cerr, c.sources, isatty(2));  // warnings, if any
   o.wp.run.parameters = o.run.parameters;
