@@ -181,7 +181,9 @@ ExitCode run(driver::Compilation& c, Options& o) {
 
 ExitCode build(driver::Compilation& c, Options& o) {
   c.options.results = o.results;
-  c.options.eliminateAlgebraics = true;  // the system `qdot run` integrates
+  c.options.eliminateAlgebraics = true;  // the system `qdot run` integrates, with its loops
+  c.options.keepLoops = true;
+  c.options.keepInvariants = o.run.invariants;  // as qdot run --invariants: every stage scalar
   if (std::string why = driver::checkOutputPath(o.exe.outputPath); !why.empty()) {
     std::cerr << "qdot: error: cannot write the executable: " << why << "\n";
     return ExitCode::Usage;
@@ -194,6 +196,9 @@ ExitCode build(driver::Compilation& c, Options& o) {
     return ExitCode::Usage;
   }
   c.diags.render(std::cerr, c.sources, isatty(2));  // warnings, if any
+  if (c.eom && c.eom->jacobiLeftOut)
+    std::cerr << "qdot: note: the executable has no Jacobi integral (the model's sums are compiled as loops, and "
+                 "the integral is a sum over every element): build with --invariants to have its column\n";
   driver::ExecutableOptions exe = o.exe;
   exe.native = o.buildBackend == "llvm";
   return driver::buildExecutable(c, exe, std::cerr);
@@ -310,6 +315,9 @@ int main(int argc, char** argv) {
   build->add_option("--outputs", o.results,
                     "compile only what these results need (the executable then writes these columns)")
       ->delimiter(',');
+  build->add_flag("--invariants", o.run.invariants,
+                  "keep the first integrals (the Jacobi integral, conserved momenta) for the executable's "
+                  "--invariants: compiled as scalars, as qdot run --invariants");
   build->add_option("--backend", o.buildBackend, "code generator: llvm (native code, default) or bytecode (the VM, linked in)")
       ->check(CLI::IsMember({"bytecode", "llvm"}));
 

@@ -319,6 +319,7 @@ class Deriver {
     bool conservative = m_.dissipation.empty() && !statedForces && m_.connectionsConserveEnergy &&
                         !lagrangian_.dependsOnTime;
     for (const auto& c : m_.constraints) conservative &= !ctx_.dependsOn(c.residual, m_.time());
+    out_.jacobiLeftOut = conservative && templated_;
     conservative &= !templated_;  // Σ v ∂L/∂v over every element: a reduction the kernels do not loop yet
     std::vector<Expr> jacobi;  // Σ v ∂L/∂v, only built when the Jacobi integral exists
     for (const auto& row : out_.rows) {
@@ -326,8 +327,12 @@ class Deriver {
       const flat::Variable& coord = m_.variables[row.coordinate];
       int v = coord.derivative;
       if (conservative) jacobi.push_back(ctx_.mul(m_.variables[v].symbol, row.momentum));
+      // A peeled element of a templated array is in the templates' sums too (the last mass of a
+      // chain: in no scalar term, but in the springs' sum).
+      auto found = extras_.find(row.coordinate);
+      bool inTemplates = found != extras_.end() && (found->second.position || found->second.dissipation);
       bool cyclic = !m_.variables[row.coordinate].alias && lagrangian_.termsOf(row.coordinate).empty() &&
-                    forcesOn(row.coordinate).empty() &&
+                    forcesOn(row.coordinate).empty() && !inTemplates &&
                     dissipation_.termsOf(v).empty() && !row.momentum->isZero();
       for (const auto& c : m_.constraints) cyclic &= !ctx_.dependsOn(c.residual, coord.symbol);
       if (cyclic)

@@ -55,6 +55,9 @@ struct EquationsOfMotion {
   std::vector<TemplateRow> templateRows;
   std::vector<Multiplier> multipliers;
   std::vector<FirstIntegral> integrals;
+  /// The system is conservative, but its rows are templates: the Jacobi integral, a sum over
+  /// every element, is not among `integrals` (the kernels do not loop reductions yet).
+  bool jacobiLeftOut = false;
   sym::Expr kinetic = nullptr, potential = nullptr, dissipation = nullptr;  ///< totals T, V, D
 };
 

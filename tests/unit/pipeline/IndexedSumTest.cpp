@@ -203,6 +203,38 @@ TEST(TemplateRows, ChainInteriorIsOneTemplateAndEqualsTheScalarRows) {
   EXPECT_EQ(rows[0].region, (std::vector<std::pair<long, long>>{{2, 5}}));
 }
 
+// First integrals with templates. Reference: the scalar derivation of the same model. The free end
+// x[n] of the undamped chain is in no scalar term but in the springs' sum: not cyclic (its momentum
+// changes whenever the last spring is stretched), which the templated derivation once missed; the
+// free particle z is cyclic in both. The Jacobi integral, a sum over every element, is left out with
+// templates, and the derivation says so.
+TEST(TemplateRows, FirstIntegralsAreThoseOfTheScalarDerivationButTheJacobiIntegral) {
+  test::SourceDae s("undamped.qd", R"(model Undamped
+  parameter Integer n = 6;
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+  coordinate Real z(start = 0);
+mechanics
+  kinetic = sum(0.5*der(x[i])^2 for i in 1:n) + 0.5*der(z)^2;
+  potential = 0.5*100*x[1]^2 + sum(0.5*100*(x[i+1] - x[i])^2 for i in 1:n-1);
+end Undamped;
+)", driver::Stage::Check);
+  Flattened f = flattenBoth(s);
+  ASSERT_TRUE(f.scalar && f.templated);
+  auto scalar = mech::deriveEquationsOfMotion(*f.scalar, s.ctx, s.diags);
+  auto templated = mech::deriveEquationsOfMotion(*f.templated, s.ctx, s.diags);
+  ASSERT_TRUE(scalar && templated);
+  ASSERT_FALSE(templated->templateRows.empty());
+  auto names = [](const mech::EquationsOfMotion& e) {
+    std::vector<std::string> out;
+    for (const auto& i : e.integrals) out.push_back(i.name);
+    return out;
+  };
+  EXPECT_EQ(names(*scalar), (std::vector<std::string>{"p(z)", "jacobi"}));
+  EXPECT_EQ(names(*templated), (std::vector<std::string>{"p(z)"}));
+  EXPECT_FALSE(scalar->jacobiLeftOut);
+  EXPECT_TRUE(templated->jacobiLeftOut);
+}
+
 TEST(TemplateRows, GridOfMassesHasItsInteriorAndEdgesAsTemplates) {
   auto rows = expectRowsMatchScalarDerivation("grid.qd", R"(model Grid
   parameter Integer n = 6, m = 5;
