@@ -53,31 +53,32 @@ class SymmetricView {
 /// O(n + nnz), and the band a hub widens is not narrowed by the order of its neighbours.
 constexpr std::size_t kSortedNeighbours = 32;
 
-/// A breadth-first search's level structure: the nodes reached from the root, level by level (in
-/// the caller's queue), the number of levels, and where the last level starts.
+/// A breadth-first search's level structure: the nodes reached from the root, level by level (at
+/// the end of the caller's queue), the number of levels, and where the last level starts.
 struct Levels {
   int64_t count = 1;
   std::size_t lastLevel = 0;
 };
 
 /// Breadth first from root over its connected component, each node's new neighbours by degree:
-/// the queue is then the Cuthill–McKee order from root. reached[v] = stamp marks the nodes met.
-Levels cuthillMcKee(const SymmetricView& g, int64_t root, std::vector<int64_t>& queue, std::vector<int64_t>& reached,
-                    int64_t stamp) {
-  queue.clear();
+/// queue[begin..] is then the Cuthill–McKee order from root (what was there before is kept).
+/// reached[v] = stamp marks the nodes met.
+Levels cuthillMcKee(const SymmetricView& g, int64_t root, std::vector<int64_t>& queue, std::size_t begin,
+                    std::vector<int64_t>& reached, int64_t stamp) {
+  queue.resize(begin);
   queue.push_back(root);
   reached[root] = stamp;
   Levels levels;
-  std::size_t levelEnd = 1;  // the level being expanded is [levels.lastLevel, levelEnd)
-  for (std::size_t head = 0; head < queue.size(); ++head) {
+  levels.lastLevel = begin;
+  std::size_t levelEnd = begin + 1;  // the level being expanded is [levels.lastLevel, levelEnd)
+  for (std::size_t head = begin; head < queue.size(); ++head) {
     if (head == levelEnd) levels.lastLevel = head, ++levels.count, levelEnd = queue.size();
     std::size_t first = queue.size();
     g.forEachNeighbour(queue[head], [&](int64_t w) {
       if (reached[w] != stamp) reached[w] = stamp, queue.push_back(w);
     });
-    auto begin = queue.begin() + static_cast<std::ptrdiff_t>(first);
     if (queue.size() - first > 1 && queue.size() - first <= kSortedNeighbours)
-      std::sort(begin, queue.end(), [&](int64_t a, int64_t b) {
+      std::sort(queue.begin() + static_cast<std::ptrdiff_t>(first), queue.end(), [&](int64_t a, int64_t b) {
         int64_t da = g.degree(a), db = g.degree(b);
         return da != db ? da < db : a < b;
       });
@@ -87,18 +88,18 @@ Levels cuthillMcKee(const SymmetricView& g, int64_t root, std::vector<int64_t>& 
 
 /// Searches from a node of least degree in the last level lengthen the level structure until it
 /// stops growing (George and Liu); each round costs one search of the component, and the rounds
-/// are capped so that the whole ordering stays linear. Returns the start it settled on, with the
-/// queue holding the Cuthill–McKee order from it (the last search's).
+/// are capped so that the whole ordering stays linear. Returns the start it settled on, with
+/// queue[begin..] holding the Cuthill–McKee order from it (the last search's).
 constexpr int kPeripheralRounds = 5;
 
-int64_t pseudoPeripheralStart(const SymmetricView& g, int64_t root, std::vector<int64_t>& queue,
+int64_t pseudoPeripheralStart(const SymmetricView& g, int64_t root, std::vector<int64_t>& queue, std::size_t begin,
                               std::vector<int64_t>& reached, int64_t& stamp) {
-  Levels levels = cuthillMcKee(g, root, queue, reached, ++stamp);
+  Levels levels = cuthillMcKee(g, root, queue, begin, reached, ++stamp);
   for (int round = 0; round < kPeripheralRounds; ++round) {
     auto last = queue.begin() + static_cast<std::ptrdiff_t>(levels.lastLevel);
     int64_t x = *std::min_element(last, queue.end(), [&](int64_t a, int64_t b) { return g.degree(a) < g.degree(b); });
     if (x == root) break;  // a component of one node
-    Levels fromX = cuthillMcKee(g, x, queue, reached, ++stamp);
+    Levels fromX = cuthillMcKee(g, x, queue, begin, reached, ++stamp);
     root = x;
     if (fromX.count <= levels.count) break;
     levels = fromX;
@@ -131,14 +132,11 @@ SuiteSparse_long orderForKlu(SuiteSparse_long n, SuiteSparse_long* Ap, SuiteSpar
 std::vector<int64_t> reverseCuthillMcKee(CscPattern pattern) {
   int64_t n = pattern.size();
   SymmetricView g(pattern);
-  std::vector<int64_t> order, queue, reached(n, 0);  // reached[v] != 0: v's component is numbered
-  order.reserve(n);
+  std::vector<int64_t> order, reached(n, 0);  // reached[v] != 0: v's component is numbered
+  order.reserve(n);  // the searches' queue: each component's numbering follows the ones before
   int64_t stamp = 0;
-  for (int64_t s = 0; s < n; ++s) {
-    if (reached[s] != 0) continue;
-    pseudoPeripheralStart(g, s, queue, reached, stamp);
-    order.insert(order.end(), queue.begin(), queue.end());
-  }
+  for (int64_t s = 0; s < n; ++s)
+    if (reached[s] == 0) pseudoPeripheralStart(g, s, order, order.size(), reached, stamp);
   std::reverse(order.begin(), order.end());
   return order;
 }
