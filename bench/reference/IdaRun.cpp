@@ -128,7 +128,6 @@ class Integrator {
   SUNLinearSolver solver_ = nullptr;
   rt::ToleranceVector tolerances_;
   std::optional<rt::TimeScale> timeScale_;  ///< computed once, from the start values, as qdot does
-  std::vector<int64_t> columnStarts_, rowIndices_;  ///< sparse: the Jacobian's pattern
   std::optional<rt::BandOrdering> bandOrdering_;    ///< qdot's KLU ordering rule (ida/KluOrdering.h)
   bool calcIC_ = false, diagonal_ = false;
  public:
@@ -205,10 +204,12 @@ void Integrator::attachLinearSolver() {
     matrix_ = created(SUNSparseMatrix(n_, n_, model_.jacobianNonzeros(), CSC_MAT, context_), "SUNSparseMatrix");
     solver_ = created(SUNLinSol_KLU(y_, matrix_, context_), "SUNLinSol_KLU");
     // qdot's rule: reverse Cuthill–McKee without BTF when it leaves a narrow band, else COLAMD.
-    columnStarts_.resize(n_ + 1), rowIndices_.resize(model_.jacobianNonzeros());
-    std::vector<double> values(rowIndices_.size());
-    model_.sparseJacobian(1.0, data(y_), data(yp_), columnStarts_.data(), rowIndices_.data(), values.data());
-    bandOrdering_ = rt::chooseBandOrdering({columnStarts_, rowIndices_});
+    std::vector<int64_t> starts(n_ + 1), rows(model_.jacobianNonzeros());
+    {
+      std::vector<double> values(rows.size());  // only the pattern is used: freed before the ordering
+      model_.sparseJacobian(1.0, data(y_), data(yp_), starts.data(), rows.data(), values.data());
+    }
+    bandOrdering_ = rt::chooseBandOrdering({starts, rows});
     if (bandOrdering_) rt::useBandOrdering(*SUNLinSol_KLUGetCommon(solver_), *bandOrdering_);
   } else {
     matrix_ = created(SUNDenseMatrix(n_, n_, context_), "SUNDenseMatrix");
