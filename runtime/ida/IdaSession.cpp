@@ -411,7 +411,7 @@ void IdaSession::Impl::attachLinearSolver() {
     // zero-free diagonal KLU factors the whole matrix instead (its fill-reducing ordering and
     // partial pivoting), which for such a model took 0.09 s.
     // A pattern that RCM turns into a narrow band is ordered so, without BTF (ida/KluOrdering.h):
-    // one breadth-first search instead of BTF and COLAMD, most of the first step at 10⁶ masses.
+    // a few breadth-first searches instead of BTF and COLAMD, most of the first step at 10⁶ masses.
     bandOrdering = chooseBandOrdering({columnStarts, rowIndices});
     if (bandOrdering) useBandOrdering(*SUNLinSol_KLUGetCommon(solver), *bandOrdering);
     blockTriangular = !bandOrdering && zeroFreeDiagonal(columnStarts, rowIndices);

@@ -25,7 +25,7 @@ struct CscPattern {
 
 /// RCM of A + Aᵀ: order[k] is the unknown placed at position k (a symmetric permutation). Each
 /// connected component is numbered from a pseudo-peripheral node (George–Liu), neighbours in order
-/// of increasing degree; the whole numbering is then reversed. Iterative, O(n + nnz).
+/// of increasing degree; the whole numbering is then reversed. Iterative, O(n + nnz); n < 2³².
 std::vector<int64_t> reverseCuthillMcKee(CscPattern pattern);
 
 /// Largest |p(i) − p(j)| over the entries (i, j), p(order[k]) = k: the half bandwidth of the

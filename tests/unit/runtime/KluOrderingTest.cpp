@@ -309,5 +309,63 @@ TEST(KluBandOrdering, ASessionSolvesAScrambledChainInItsBand) {
   EXPECT_LT(worst, 100 * rtol);
 }
 
+/// Heat conduction on an m × m grid of cells (5-point Laplacian, zero at the border), started in
+/// its lowest eigenmode sin(πih) sin(πjh): it decays as exp(−2λt), λ = 4/h² sin²(πh/2).
+HandModel heatGrid(int m) {
+  HandModel g;
+  g.name = "grid";
+  double h = 1.0 / (m + 1), k = 1.0 / (h * h);
+  auto id = [m](int i, int j) { return i * m + j; };
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j) {
+      g.variables.push_back("T[" + std::to_string(i + 1) + "," + std::to_string(j + 1) + "]");
+      g.differential.push_back(1);
+      g.start.push_back(std::sin(std::numbers::pi * (i + 1) * h) * std::sin(std::numbers::pi * (j + 1) * h));
+      g.entries.emplace_back(id(i, j), id(i, j));
+      if (i > 0) g.entries.emplace_back(id(i, j), id(i - 1, j)), g.entries.emplace_back(id(i - 1, j), id(i, j));
+      if (j > 0) g.entries.emplace_back(id(i, j), id(i, j - 1)), g.entries.emplace_back(id(i, j - 1), id(i, j));
+    }
+  auto at = [m](const double* y, int i, int j) { return i < 0 || j < 0 || i >= m || j >= m ? 0.0 : y[i * m + j]; };
+  g.residual = [m, k, at](double, const double* y, const double* yp, const double*, double* F) {
+    for (int i = 0; i < m; ++i)
+      for (int j = 0; j < m; ++j)
+        F[i * m + j] = yp[i * m + j] - k * (at(y, i - 1, j) + at(y, i + 1, j) + at(y, i, j - 1) + at(y, i, j + 1) -
+                                            4 * y[i * m + j]);
+    return 0;
+  };
+  g.jacobian = [m, k](double, const double*, const double*, const double*, double cj, JacobianValues& J) {
+    for (int i = 0; i < m; ++i)
+      for (int j = 0; j < m; ++j) {
+        int v = i * m + j;
+        J(v, v) = cj + 4 * k;
+        if (i > 0) J(v, v - m) = J(v - m, v) = -k;
+        if (j > 0) J(v, v - 1) = J(v - 1, v) = -k;
+      }
+    return 0;
+  };
+  return g;
+}
+
+// A 2-D grid is no narrow band: KLU keeps COLAMD (and BTF), and the session says so.
+TEST(KluBandOrdering, ASessionOnAGridKeepsColamd) {
+  const int m = 40;
+  const double rtol = 1e-7, h = 1.0 / (m + 1);
+  const double lambda = 4.0 / (h * h) * std::pow(std::sin(std::numbers::pi * h / 2), 2);
+  HandModel model = heatGrid(m);
+  MemorySink sink;
+  SimulationSettings s;
+  s.stop = 0.01, s.interval = 0.005, s.rtol = rtol;
+  SimulationResult r = simulate(model.abi(), s, sink);
+  ASSERT_TRUE(r.success) << r.message;
+  EXPECT_EQ(r.linearSolver, LinearSolverKind::Klu);
+  EXPECT_FALSE(r.bandwidth);
+  EXPECT_TRUE(r.blockTriangular);
+  double worst = 0;
+  for (std::size_t k = 0; k < sink.rows.size(); ++k)
+    for (int v = 0; v < m * m; ++v)
+      worst = std::max(worst, std::abs(sink.rows[k][v] - std::exp(-2 * lambda * sink.times[k]) * model.start[v]));
+  EXPECT_LT(worst, 100 * rtol);
+}
+
 }  // namespace
 }  // namespace qdot::rt::test
