@@ -39,6 +39,7 @@ struct RunResult {
   bool computedInitialValues = false;
   bool diagonalRates = false;  ///< y' made consistent by one division (else IDACalcIC), if computed
   bool sparse = false;
+  std::optional<int64_t> bandwidth;  ///< KLU ordered as a band of this half width (qdot's rule), else COLAMD
   std::size_t rows = 0;
   rt::ToleranceSummary tolerances;
   double setupSeconds = 0;  ///< IDA set up, consistent start

@@ -118,6 +118,9 @@ class IdaSession {
   /// KLU: whether it permutes the matrix to block triangular form first (not when the Jacobian's
   /// diagonal has structural zeros: finding the permutation could then cost O(n · nnz)).
   bool blockTriangular() const;
+  /// KLU: the half bandwidth when it factors the matrix in reverse Cuthill–McKee order (a narrow
+  /// band: ida/KluOrdering.h, without BTF); nullopt when it orders by COLAMD.
+  std::optional<int64_t> bandwidth() const;
   bool computedInitialValues() const;                ///< whether the start values were changed
   InitialValueMethod initialValueMethod() const;
   /// When IDA had completed its first step (seen at the next residual evaluation), if it has: the

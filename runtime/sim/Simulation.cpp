@@ -164,6 +164,7 @@ void collect(SimulationResult& r, const Session& session) {
   r.computedInitialValues = session.computedInitialValues();
   r.initialValues = session.initialValueMethod();
   if constexpr (requires { session.blockTriangular(); }) r.blockTriangular = session.blockTriangular();
+  if constexpr (requires { session.bandwidth(); }) r.bandwidth = session.bandwidth();
   r.warnings = session.warnings();
   try {
     r.stats = session.stats();

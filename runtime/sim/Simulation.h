@@ -80,6 +80,7 @@ struct SimulationResult {
   LinearSolverKind linearSolver = LinearSolverKind::Auto;  ///< as resolved (Auto if setup failed)
   bool linearSolverChosenAutomatically = false;            ///< --linear-solver auto
   bool blockTriangular = true;  ///< KLU: permuted to block triangular form first (IdaSession::blockTriangular)
+  std::optional<int64_t> bandwidth;  ///< KLU: ordered as a band of this half width (IdaSession::bandwidth), else COLAMD
   bool computedInitialValues = false;
   InitialValueMethod initialValues = InitialValueMethod::AsGiven;
   std::vector<std::string> warnings;

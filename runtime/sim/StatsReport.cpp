@@ -44,9 +44,10 @@ std::string formatStats(const SimulationResult& r) {
   line(out, "linear solver",
        fmt::format("{} ({}{})", linearSolverName(r.linearSolver),
                    r.linearSolverChosenAutomatically ? "chosen automatically" : "as requested",
-                   r.linearSolver == LinearSolverKind::Klu && !r.blockTriangular
-                       ? "; without block triangular form: the Jacobian's diagonal has structural zeros"
-                       : ""));
+                   r.linearSolver != LinearSolverKind::Klu ? ""
+                   : r.bandwidth ? fmt::format("; band ordering, bandwidth {}", *r.bandwidth)
+                   : !r.blockTriangular ? "; without block triangular form: the Jacobian's diagonal has structural zeros"
+                                        : ""));
   if (!s.dummyDerivatives.empty())
     line(out, "dummy derivatives",
          fmt::format("{} (index reduction; chosen again {} time{} during the run)", s.dummyDerivatives, s.dummyChanges,
