@@ -62,6 +62,7 @@ class Builder {
   std::vector<char> kinematicTaken_;  ///< per kinematic row (templated models): a template's
   std::vector<std::pair<int, int>> kinematicPairs_;  ///< per kinematic row: coordinate, velocity (index among velocities)
   std::unordered_map<Expr, Expr> aliases_;  ///< symbol of a variable that is not an unknown → its value
+  std::vector<Expr> aliasTable_;            ///< the same by symbol id (null: no alias), for substituting
   uint64_t aliasMask_ = 0;
   std::vector<char> appears_;               ///< by symbol id: in some equation (after substitution)
 
@@ -77,9 +78,12 @@ class Builder {
         if (next == to) break;
         to = next;
       }
+    if (aliases_.empty()) return;
+    aliasTable_.assign(ctx_.symbolCount(), nullptr);
+    for (const auto& [from, to] : aliases_) aliasTable_[from->symbolId] = to;
   }
 
-  Expr substituted(Expr e) { return aliases_.empty() || !e ? e : ctx_.substitute(e, aliases_, aliasMask_); }
+  Expr substituted(Expr e) { return aliases_.empty() || !e ? e : ctx_.substitute(e, aliasTable_, aliasMask_); }
 
   // Which symbols the equations contain: decides what kind of unknown each coordinate is.
   void markAppearances() {

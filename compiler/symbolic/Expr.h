@@ -134,6 +134,10 @@ class Context {
   /// expressions then costs nothing per key.
   Expr substitute(Expr e, const std::unordered_map<Expr, Expr>& map, uint64_t keyMask);
   static uint64_t keyMaskOf(const std::unordered_map<Expr, Expr>& map);
+  /// The same for symbol keys given as a table by symbol id (null: kept), keyMask that of its
+  /// keys: a lookup per node instead of a hash lookup, for a large map applied to many expressions
+  /// (a model's aliases).
+  Expr substitute(Expr e, std::span<const Expr> bySymbolId, uint64_t keyMask);
 
   /// True if symbol s occurs in e (exact; uses the mask to answer "no" fast).
   bool dependsOn(Expr e, Expr s) const;

@@ -15,18 +15,22 @@ Expr Context::substitute(Expr e, const std::unordered_map<Expr, Expr>& map) {
   return substitute(e, map, keyMaskOf(map));
 }
 
-Expr Context::substitute(Expr e, const std::unordered_map<Expr, Expr>& map, uint64_t keyMask) {
-  if (map.empty() || !(e->symbolMask & keyMask)) return e;
-  auto enter = [&](Expr n) { return (n->symbolMask & keyMask) && !map.count(n); };
+namespace {
+
+// The one pass both forms share; replacement(n) is n's replacement or nullptr.
+template <class Replacement>
+Expr substituteBy(Context::Impl& impl, Expr e, uint64_t keyMask, Replacement&& replacement) {
+  if (!(e->symbolMask & keyMask)) return e;
+  auto enter = [&](Expr n) { return (n->symbolMask & keyMask) && !replacement(n); };
   PostOrder po = postOrder(std::span<const Expr>(&e, 1), enter);
 
   std::vector<Expr> result(po.order.size());
   std::vector<Expr> kids;
   for (size_t i = 0; i < po.order.size(); ++i) {
     Expr n = po.order[i];
-    if (auto it = map.find(n); it != map.end()) {
-      result[i] = it->second;
-    } else if (!enter(n) || childCount(n) == 0) {
+    if (Expr to = replacement(n)) {
+      result[i] = to;
+    } else if (!(n->symbolMask & keyMask) || childCount(n) == 0) {
       result[i] = n;
     } else {
       kids.clear();
@@ -38,10 +42,26 @@ Expr Context::substitute(Expr e, const std::unordered_map<Expr, Expr>& map, uint
       // A node whose mask only seemed to meet the keys' (64 bits for all symbols: with many keys
       // every node does) is itself; rebuilding it would find the same node, at the cost of
       // canonicalising it again.
-      result[i] = changed ? impl_->rebuild(n, kids) : n;
+      result[i] = changed ? impl.rebuild(n, kids) : n;
     }
   }
   return result.back();
+}
+
+}  // namespace
+
+Expr Context::substitute(Expr e, const std::unordered_map<Expr, Expr>& map, uint64_t keyMask) {
+  if (map.empty()) return e;
+  return substituteBy(*impl_, e, keyMask, [&](Expr n) -> Expr {
+    auto it = map.find(n);
+    return it == map.end() ? nullptr : it->second;
+  });
+}
+
+Expr Context::substitute(Expr e, std::span<const Expr> bySymbolId, uint64_t keyMask) {
+  return substituteBy(*impl_, e, keyMask, [&](Expr n) -> Expr {
+    return n->isSymbol() && n->symbolId < bySymbolId.size() ? bySymbolId[n->symbolId] : nullptr;
+  });
 }
 
 }  // namespace qdot::sym
