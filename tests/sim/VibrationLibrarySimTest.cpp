@@ -570,6 +570,29 @@ TEST(VibrationLibrary, ChainOfComponentArraysEqualsTheFlatChain) {
   }
 }
 
+// The same chain's link forces: `qdot run` solves them out of the system (dae/ExplicitAlgebraics.h)
+// and computes them with the results, so the run integrates the 2n states alone (every unknown
+// differential: y'(t0) by one division, no IDACalcIC). Reference: each link's law, b.f = k (s_i −
+// s_{i−1}) + c (v_i − v_{i−1}) with the wall at s_0 = 0 (k = 1000, c = 0.5), at every written row, to
+// rounding; the two flanges of a link carry opposite forces.
+TEST(VibrationLibrary, ChainOfComponentArraysComputesItsLinkForcesFromTheStates) {
+  auto r = runQdot("tests/sim/models/chain_components.qd", {"--rtol", num(kRtol), "--stats"});
+  ASSERT_EQ(r.exitCode, 0) << r.log;
+  EXPECT_NE(r.log.find("made consistent directly"), std::string::npos) << r.log;
+  const double k = 1000, c = 0.5;
+  for (int i = 1; i <= 10; ++i) {
+    const std::string at = "[" + std::to_string(i) + "]", before = "[" + std::to_string(i - 1) + "]";
+    const auto &s = r.col("ms" + at + ".s"), &v = r.col("der(ms" + at + ".s)"), &f = r.col("links" + at + ".b.f");
+    const auto &fa = r.col("links" + at + ".a.f");
+    for (std::size_t row = 0; row < r.rows; ++row) {
+      double s0 = i == 1 ? 0.0 : r.col("ms" + before + ".s")[row], v0 = i == 1 ? 0.0 : r.col("der(ms" + before + ".s)")[row];
+      double law = k * (s[row] - s0) + c * (v[row] - v0);
+      ASSERT_NEAR(f[row], law, 1e-12 * (1 + std::fabs(law))) << "links" << at << " at t = " << r.time()[row];
+      ASSERT_NEAR(fa[row], -f[row], 1e-12 * (1 + std::fabs(law))) << "links" << at << " at t = " << r.time()[row];
+    }
+  }
+}
+
 // The chain's masses x[i] and velocities v[i] of a chain written as equations, against the chain
 // derived from its energies (spring_chain.qd, n = 10): the same equations of motion reached by
 // another path (no Euler–Lagrange derivation).
