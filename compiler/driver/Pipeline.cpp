@@ -16,7 +16,6 @@
 
 #include "bodies/RigidBodies.h"
 #include "bytecode/Emitter.h"
-#include "dae/ExplicitAlgebraics.h"
 #include "dae/IndexReduction.h"
 #include "dae/TemplateOde.h"
 #include "syntax/Parser.h"
@@ -168,7 +167,7 @@ bool buildDae(Compilation& c) {
     // A templated DAE is an ODE in the accelerations of one row per coordinate (index 1), and its
     // coordinates are coupled along the arrays: nothing to reduce, nothing worth pruning.
     if (d && d->templated()) return d;
-    if (d && c.options.eliminateAlgebraics) dae::eliminateExplicitAlgebraics(*d, c.ctx);
+    if (d && c.options.eliminateAlgebraics) c.eliminated = dae::eliminateExplicitAlgebraics(*d, c.ctx);
     if (d && !c.options.results.empty()) {
       std::vector<std::string> names = c.options.results;
       if (c.options.keepInvariants)

@@ -16,6 +16,7 @@
 
 #include "ast/AST.h"
 #include "dae/Dae.h"
+#include "dae/ExplicitAlgebraics.h"
 #include "dae/Prune.h"
 #include "flatten/Flatten.h"
 #include "kernel/Kernel.h"
@@ -82,6 +83,7 @@ struct Compilation {
   std::optional<mech::EquationsOfMotion> eom;
   std::optional<dae::Dae> dae;
   dae::PruneReport pruned;  ///< what --outputs kept
+  dae::EliminationReport eliminated;  ///< explicit algebraic unknowns solved out (eliminateAlgebraics)
   flat::Experiment experiment;  ///< the DAE's experiment annotation (kept when the DAE is released)
   std::shared_ptr<const kernel::KernelModule> kernels;
   std::optional<bc::Module> bytecode;

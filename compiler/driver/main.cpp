@@ -166,6 +166,9 @@ ExitCode run(driver::Compilation& c, Options& o) {
   if (!m.warning.empty()) std::cerr << "qdot: warning: " << m.warning << "\n";
   c.diags.render(std::cerr, c.sources, isatty(2));  // warnings, if any
   if (o.run.stats) printCompileStats(c.times, m);
+  if (o.run.stats && c.eliminated.eliminated)
+    std::cerr << "system: " << c.eliminated.eliminated << " algebraic unknowns that their equations define "
+              << "explicitly are solved out and computed with the results (qdot equations shows them)\n";
   ExitCode code = rt::runModel(*m.model, o.run, experimentOf(c.experiment), std::cout, std::cerr);
   std::optional<rt::TierReport> tiers = driver::reportTiers(m, o.run.stats, std::cerr);
   if (tiers && tiers->compiling) {

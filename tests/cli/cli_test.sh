@@ -151,6 +151,11 @@ contains max-steps-rows "rows up to t =" "$qdot" run "$src/examples/textbook/utu
 # --invariants (the kernels have no reductions, so such a run keeps every stage scalar).
 contains emit-kernel-loop "equations of elements" "$qdot" run "$src/examples/heat/rod.qd" --emit=kernel
 check emit-kernel-invariants-scalar 1 sh -c "'$qdot' run '$src/examples/heat/rod.qd' --emit=kernel --invariants | grep -q 'equations of elements'"
+# The beating oscillators' six connector flows are defined explicitly by their components' rows:
+# `qdot run` integrates the four states alone and says so; `qdot equations` shows the flows.
+contains stats-solved-out "system: 6 algebraic unknowns" "$qdot" run "$src/examples/vibration/beating.qd" --stop 0.01 -o /dev/null --stats
+contains equations-keep-flows "k1.b.f" "$qdot" equations "$src/examples/vibration/beating.qd"
+check emit-kernel-no-flow-unknowns 1 sh -c "'$qdot' run '$src/examples/vibration/beating.qd' --emit=kernel | grep '^variables' | grep -q 'k1.b.f'"
 rm -f /tmp/qdot_cli_out.$$
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
