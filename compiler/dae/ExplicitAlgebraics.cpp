@@ -112,10 +112,7 @@ class Eliminator {
   sym::Expr replaced(sym::Expr e, sym::Expr zs, sym::Expr value) {
     int at = directTerm(e, zs);
     if (at < 0) return ctx_.substitute(e, {{zs, value}});
-    std::vector<sym::Expr> terms{ctx_.constant(e->value), scaledSum(e->coefs[at], value)};
-    for (size_t i = 0; i < e->args.size(); ++i)
-      if (static_cast<int>(i) != at) terms.push_back(ctx_.scale(e->coefs[i], e->args[i]));
-    return ctx_.add(terms);
+    return combination(e, at, 1.0, value, e->coefs[at]);
   }
 
   bool eliminate(int z) {
@@ -150,10 +147,19 @@ class Eliminator {
   // k·e, a sum scaled term by term (k·(a + b) would stay a product: the canonical form does not
   // distribute, and the value is printed as a result's formula).
   sym::Expr scaledSum(double k, sym::Expr e) {
-    if (e->kind != sym::Kind::Add) return ctx_.scale(k, e);
-    std::vector<sym::Expr> terms{ctx_.constant(k * e->value)};
-    for (size_t i = 0; i < e->args.size(); ++i) terms.push_back(ctx_.scale(k * e->coefs[i], e->args[i]));
-    return ctx_.add(terms);
+    if (e->kind != sym::Kind::Add || k == 1.0) return ctx_.scale(k, e);
+    return combination(e, -1, k, nullptr);
+  }
+
+  // Σ over the terms of the sum e but the one at `skip`, each scaled by k, plus k·e's constant and
+  // c·value: one sum built at once.
+  sym::Expr combination(sym::Expr e, int skip, double k, sym::Expr value, double c = 0) {
+    std::vector<sym::Expr> terms{ctx_.one()};
+    std::vector<double> coefs{k * e->value};
+    for (size_t i = 0; i < e->args.size(); ++i)
+      if (static_cast<int>(i) != skip) terms.push_back(e->args[i]), coefs.push_back(k * e->coefs[i]);
+    if (value) terms.push_back(value), coefs.push_back(c);
+    return ctx_.linearCombination(terms, coefs);
   }
 
   void substituteInRow(Equation& eq, int row, sym::Expr zs, sym::Expr value) {

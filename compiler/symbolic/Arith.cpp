@@ -246,6 +246,13 @@ Expr Context::sub(Expr a, Expr b) {
 
 Expr Context::neg(Expr a) { return scale(-1.0, a); }
 
+Expr Context::linearCombination(std::span<const Expr> terms, std::span<const double> coefs) {
+  AddBuilder s(*this);
+  s.reserve(terms.size());
+  for (size_t i = 0; i < terms.size(); ++i) s.add(coefs[i], terms[i]);
+  return s.build();
+}
+
 Expr Context::scale(double c, Expr a) {
   if (c == 1.0) return a;
   MulBuilder m(*this, c);

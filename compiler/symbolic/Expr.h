@@ -115,6 +115,8 @@ class Context {
   Expr div(Expr a, Expr b);
   Expr pow(Expr base, Expr exponent);
   Expr scale(double c, Expr a);  ///< c * a
+  /// Σ coefs[i]·terms[i] built as one sum: add() of the scaled terms, without a product per term.
+  Expr linearCombination(std::span<const Expr> terms, std::span<const double> coefs);
 
   // --- functions ---------------------------------------------------------------------------
   /// Any unary function kind (Sin … Sign, Not). sqrt is pow(x, 0.5); log10(x) is log(x)/log(10).
