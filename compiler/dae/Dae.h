@@ -80,6 +80,9 @@ struct Invariant {
   std::string name;
   std::string kind;  ///< "cyclic momentum" or "Jacobi integral"
   sym::Expr value = nullptr;
+  /// Added to `value`: sums over every element (mech::FirstIntegral::sums), over relative symbols
+  /// (Dae::patterns) whose elements are unknowns (their y) or parameters.
+  std::vector<flat::IndexedTerm> sums;
 };
 
 /// Rows of F given by one template (issue 15, docs/loops.md): the rows of the elements of an array

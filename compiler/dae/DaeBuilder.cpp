@@ -3,6 +3,7 @@
 #include "dae/Dae.h"
 #include "dae/Balance.h"
 #include "dae/TemplateOde.h"
+#include "flatten/Flatten.h"
 #include "support/Assert.h"
 
 #include <algorithm>
@@ -42,9 +43,10 @@ class Builder {
     addUnknowns();
     for (const auto& fi : eom_.integrals)
       dae_.invariants.push_back({fi.name, fi.kind == mech::FirstIntegral::Kind::Jacobi ? "Jacobi integral" : "cyclic momentum",
-                                 substituted(fi.value)});
+                                 substituted(fi.value), fi.sums});
     if (!aliases_.empty()) substituteRest();
     if (!eom_.templateRows.empty()) addTemplateBlocks(), addScalarKinematicResiduals();
+    if (!dae_.templated()) expandInvariantSums();
     // Template rows are one Euler–Lagrange row per coordinate and its kinematic row by construction.
     if (diags_.errorCount() == errorsBefore && !dae_.templated()) checkBalance(dae_, ctx_, diags_);
     if (diags_.errorCount() > errorsBefore) return std::nullopt;
@@ -52,6 +54,18 @@ class Builder {
   }
 
  private:
+  // Without template rows (every element peeled) the structural passes see scalars: an
+  // invariant's sums become its terms at every point.
+  void expandInvariantSums() {
+    for (Invariant& inv : dae_.invariants) {
+      std::vector<Expr> terms{inv.value};
+      for (const flat::IndexedTerm& sum : inv.sums)
+        flat::forEachPoint(sum.box, [&](std::span<const long> p, size_t) { terms.push_back(flat::instantiate(m_, ctx_, sum.body, p)); });
+      inv.value = ctx_.add(terms);
+      inv.sums.clear();
+    }
+  }
+
   const flat::FlatModel& m_;
   const mech::EquationsOfMotion& eom_;
   sym::Context& ctx_;

@@ -92,9 +92,9 @@ bool loopsReadSum(const flat::FlatModel& m, const flat::IndexedSum& sum, const s
 
 // Where the stages after flattening take templates (docs/loops.md): a model of energies over
 // coordinates only — no equations, constraints, components or aliases (their structural passes
-// work on scalars) — and a run that needs no invariants (a sum over every element).
+// work on scalars). Its Jacobi integral is a sum over every element: the kernels loop it too.
 bool templatesApply(const flat::FlatModel& m, const CompileOptions& o, const sym::Context& ctx) {
-  if (!o.keepLoops || m.indexedSums.empty() || o.keepInvariants) return false;
+  if (!o.keepLoops || m.indexedSums.empty()) return false;
   if (!m.equations.empty() || !m.initialEquations.empty() || !m.constraints.empty() || m.components.size() > 1) return false;
   bool plain = std::none_of(m.variables.begin(), m.variables.end(), [](const flat::Variable& v) {
     return v.alias || v.role == flat::VarRole::Unknown || v.role == flat::VarRole::Derivative;

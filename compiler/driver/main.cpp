@@ -186,7 +186,7 @@ ExitCode build(driver::Compilation& c, Options& o) {
   c.options.results = o.results;
   c.options.eliminateAlgebraics = true;  // the system `qdot run` integrates, with its loops
   c.options.keepLoops = true;
-  c.options.keepInvariants = o.run.invariants;  // as qdot run --invariants: every stage scalar
+  c.options.keepInvariants = o.run.invariants;  // as qdot run --invariants
   if (std::string why = driver::checkOutputPath(o.exe.outputPath); !why.empty()) {
     std::cerr << "qdot: error: cannot write the executable: " << why << "\n";
     return ExitCode::Usage;
@@ -199,9 +199,6 @@ ExitCode build(driver::Compilation& c, Options& o) {
     return ExitCode::Usage;
   }
   c.diags.render(std::cerr, c.sources, isatty(2));  // warnings, if any
-  if (c.eom && c.eom->jacobiLeftOut)
-    std::cerr << "qdot: note: the executable has no Jacobi integral (the model's sums are compiled as loops, and "
-                 "the integral is a sum over every element): build with --invariants to have its column\n";
   driver::ExecutableOptions exe = o.exe;
   exe.native = o.buildBackend == "llvm";
   return driver::buildExecutable(c, exe, std::cerr);
@@ -320,7 +317,7 @@ int main(int argc, char** argv) {
       ->delimiter(',');
   build->add_flag("--invariants", o.run.invariants,
                   "keep the first integrals (the Jacobi integral, conserved momenta) for the executable's "
-                  "--invariants: compiled as scalars, as qdot run --invariants");
+                  "--invariants also when --outputs leaves out what they need");
   build->add_option("--backend", o.buildBackend, "code generator: llvm (native code, default) or bytecode (the VM, linked in)")
       ->check(CLI::IsMember({"bytecode", "llvm"}));
 

@@ -198,6 +198,16 @@ struct IndexedSum {
   SourceRange range;  ///< the sum(...) call
 };
 
+/// Σ over a box of iterator values of `body`, an expression over relative symbols (%k: iterator k)
+/// whose arrays have `shape` and are subscripted in dimension d by iterator d plus a constant (in one
+/// dimension, any length): a sum over every element that a loop computes (issue 15) — a templated
+/// model's Jacobi integral.
+struct IndexedTerm {
+  Box box;
+  std::vector<int> shape;
+  sym::Expr body = nullptr;
+};
+
 /// `for i in a:b, j in c:d loop der(x[i, j]) = rhs; end for` kept as one template instead of one
 /// equation per point (issue 15, docs/loops.md): the equation at every point of the box, its sides
 /// over relative symbols (`der(x)[%1,%2]`, `x[%1+1,%2]`), parameters and time. Only the loops whose

@@ -46,6 +46,7 @@ size_t stepLoop(const Program& prog, size_t i, LoopState& s) {
 #define QDOT_KERNEL_Store(E) out[I] = (E);
 #define QDOT_KERNEL_StoreLooped(E) out[I + L] = (E);
 #define QDOT_KERNEL_StoreIndexed(E) out[X[I + c]] = (E);
+#define QDOT_KERNEL_StoreAdd(E) out[I] += (E);
 #define QDOT_KERNEL_LoopBegin(E) next = stepLoop(prog, i, loop);
 #define QDOT_KERNEL_LoopEnd(E) next = stepLoop(prog, i, loop);
 

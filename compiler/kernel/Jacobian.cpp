@@ -121,14 +121,15 @@ std::optional<ElementBase> uniformBase(const flat::ArrayVariable& a, const Unkno
   return base;
 }
 
-// Where relative symbol `rel` of `block` reads: the unknown of the array element with linear index
-// 0 (possibly not an element the block reads, or not an unknown at all: only an index base) and
-// whether it is y'. Every element the block reads — its region shifted by the pattern's offsets —
-// must be the unknown base + its linear index, of one kind: the loop addresses them so.
-ElementBase unknownsRead(const dae::TemplateBlock& block, const flat::RelativeElement& rel, const flat::ArrayVariable& a,
+// Where relative symbol `rel` of a template over `region` reads: the unknown of the array element
+// with linear index 0 (possibly not an element the template reads, or not an unknown at all: only
+// an index base) and whether it is y'. Every element it reads — the region shifted by the
+// pattern's offsets — must be the unknown base + its linear index, of one kind: the loop
+// addresses them so.
+ElementBase unknownsRead(const flat::Box& region, const flat::RelativeElement& rel, const flat::ArrayVariable& a,
                          const UnknownSymbols& unknowns) {
   std::optional<ElementBase> base;
-  flat::forEachPoint(block.region, [&](std::span<const long> p, size_t) {
+  flat::forEachPoint(region, [&](std::span<const long> p, size_t) {
     long k = 0;
     for (size_t d = 0; d < p.size(); ++d) k = k * a.shape[d] + (p[d] + rel.dims[d].offset - 1);
     std::optional<UnknownSymbols::Unknown> e = unknowns.find(a.elements[static_cast<size_t>(k)]);
@@ -152,19 +153,19 @@ int parameterBase(const flat::ArrayVariable& a, const std::vector<int>& paramete
   return first;
 }
 
-// Subscript d is the block's iterator d plus a constant, and the array has the block's strides (its
-// shape in more than one dimension): element index = the block's linear index + the offset.
-bool loopsAlong(const flat::RelativeElement& rel, const flat::ArrayVariable& a, const dae::TemplateBlock& block) {
-  if (rel.dims.size() != block.shape.size() || (rel.dims.size() > 1 && a.shape != block.shape)) return false;
+// Subscript d is the template's iterator d plus a constant, and the array has the template's
+// strides (its shape in more than one dimension): element index = the linear index + the offset.
+bool loopsAlong(const flat::RelativeElement& rel, const flat::ArrayVariable& a, const std::vector<int>& shape) {
+  if (rel.dims.size() != shape.size() || (rel.dims.size() > 1 && a.shape != shape)) return false;
   for (size_t d = 0; d < rel.dims.size(); ++d)
     if (rel.dims[d].iterator != static_cast<int>(d)) return false;
   return true;
 }
 
-// Per symbol id, the index of the parameter it is (-1: none); empty without template blocks.
+// Per symbol id, the index of the parameter it is (-1: none); empty without templates.
 std::vector<int> parameterIndices(const dae::Dae& dae) {
   std::vector<int> of;
-  if (!dae.templated()) return of;
+  if (!dae.patterns) return of;
   for (size_t k = 0; k < dae.parameters.size(); ++k) {
     uint32_t id = dae.parameters[k].symbol->symbolId;
     if (of.size() <= id) of.resize(id + 1, -1);
@@ -173,41 +174,44 @@ std::vector<int> parameterIndices(const dae::Dae& dae) {
   return of;
 }
 
-// Per template block, its relative symbols with where they are read: an array of unknowns, or of
-// parameters consecutive in p, indexed by the block's iterators in order (of the block's shape in
-// more than one dimension) — the pipeline keeps templates only then.
-std::vector<std::vector<TemplateOperand>> templateOperands(const dae::Dae& dae, const sym::Context& ctx,
-                                                           const UnknownSymbols& unknowns) {
-  std::vector<std::vector<TemplateOperand>> out(dae.templateBlocks.size());
-  size_t arrays = out.empty() ? 0 : dae.patterns->arrays.size();
-  std::vector<int> parameterOf = parameterIndices(dae);
-  std::vector<char> looked(arrays, 0);
-  std::vector<std::optional<ElementBase>> uniform(arrays);
-  std::vector<int> parameters(arrays, -1);
-  for (size_t b = 0; b < out.size(); ++b) {
-    const dae::TemplateBlock& block = dae.templateBlocks[b];
-    for (sym::Expr s : ctx.freeSymbols(block.residual)) {
-      const flat::RelativeElement* rel = dae.patterns->find(s);
-      if (!rel) continue;
-      const flat::ArrayVariable& a = dae.patterns->arrays[rel->array];
-      if (!looked[rel->array]) {
-        looked[rel->array] = 1;
-        parameters[rel->array] = parameterBase(a, parameterOf);
-        if (parameters[rel->array] < 0) uniform[rel->array] = uniformBase(a, unknowns);
-      }
-      long offset = 0;
-      for (size_t d = 0; d < rel->dims.size(); ++d) offset = offset * block.shape[d] + rel->dims[d].offset;
-      if (int first = parameters[rel->array]; first >= 0) {
-        QDOT_ASSERT(loopsAlong(*rel, a, block), "a template reads a parameter array across its iterators");
-        out[b].push_back({s, first, false, true, offset});
-        continue;
-      }
-      auto [variable, derivative] = uniform[rel->array] ? *uniform[rel->array] : unknownsRead(block, *rel, a, unknowns);
-      out[b].push_back({s, variable, derivative, false, offset});
+}  // namespace
+
+LoopOperands::LoopOperands(const dae::Dae& dae, const sym::Context& ctx, const UnknownSymbols& unknowns)
+    : dae_(dae), ctx_(ctx), unknowns_(unknowns), parameterOf_(parameterIndices(dae)) {
+  size_t arrays = dae.patterns ? dae.patterns->arrays.size() : 0;
+  looked_.assign(arrays, 0);
+  uniform_.assign(arrays, std::nullopt);
+  parameters_.assign(arrays, -1);
+}
+
+// The relative symbols of a template with where they are read: an array of unknowns, or of
+// parameters consecutive in p, indexed by the template's iterators in order (of its shape in more
+// than one dimension) — the pipeline keeps templates only then.
+std::vector<TemplateOperand> LoopOperands::read(const std::vector<int>& shape, const flat::Box& region, sym::Expr e) {
+  std::vector<TemplateOperand> out;
+  for (sym::Expr s : ctx_.freeSymbols(e)) {
+    const flat::RelativeElement* rel = dae_.patterns ? dae_.patterns->find(s) : nullptr;
+    if (!rel) continue;
+    const flat::ArrayVariable& a = dae_.patterns->arrays[rel->array];
+    if (!looked_[rel->array]) {
+      looked_[rel->array] = 1;
+      parameters_[rel->array] = parameterBase(a, parameterOf_);
+      if (parameters_[rel->array] < 0) uniform_[rel->array] = uniformBase(a, unknowns_);
     }
+    long offset = 0;
+    for (size_t d = 0; d < rel->dims.size(); ++d) offset = offset * shape[d] + rel->dims[d].offset;
+    if (int first = parameters_[rel->array]; first >= 0) {
+      QDOT_ASSERT(loopsAlong(*rel, a, shape), "a template reads a parameter array across its iterators");
+      out.push_back({s, first, false, true, offset});
+      continue;
+    }
+    auto [variable, derivative] = uniform_[rel->array] ? *uniform_[rel->array] : unknownsRead(region, *rel, a, unknowns_);
+    out.push_back({s, variable, derivative, false, offset});
   }
   return out;
 }
+
+namespace {
 
 // The entries of block b: ∂F/∂y + cj ∂F/∂y' per column pattern (positions are sized, not yet given).
 void templateEntries(const dae::Dae& dae, sym::Context& ctx, sym::Expr cj, size_t b, std::span<const TemplateOperand> operands,
@@ -312,7 +316,9 @@ class PatternLayout {
 JacobianEntries differentiate(const dae::Dae& dae, const UnknownSymbols& unknowns, sym::Context& ctx, sym::Expr cj) {
   std::vector<RowEntry> scalar = scalarEntries(dae, ctx, cj, unknowns);
   JacobianEntries J;
-  J.templateOperands = templateOperands(dae, ctx, unknowns);
+  LoopOperands operands(dae, ctx, unknowns);
+  for (const dae::TemplateBlock& block : dae.templateBlocks)
+    J.templateOperands.push_back(operands.read(block.shape, block.region, block.residual));
   for (size_t b = 0; b < dae.templateBlocks.size(); ++b) templateEntries(dae, ctx, cj, b, J.templateOperands[b], J.templateEntries);
   PatternLayout(dae, J).run(scalar);
   return J;

@@ -3,6 +3,10 @@
 // dF/dy_j and cj*dF/dy'_j land in the same entry).
 #pragma once
 
+#include <optional>
+#include <utility>
+#include <vector>
+
 #include "dae/Dae.h"
 #include "kernel/Unknowns.h"
 
@@ -17,6 +21,25 @@ struct TemplateOperand {
   bool derivative = false;  ///< y' (else y)
   bool parameter = false;   ///< p (a constant of the rows: no Jacobian column)
   long offset = 0;
+};
+
+/// Reads the relative symbols of templates (template blocks, an invariant's sums) as loop operands;
+/// what it finds per array is kept for the next template.
+class LoopOperands {
+ public:
+  LoopOperands(const dae::Dae& dae, const sym::Context& ctx, const UnknownSymbols& unknowns);
+  /// The relative symbols of `e`, a template over `region` (subscripts or iterator values) whose
+  /// arrays have `shape`, each with where a loop reads it.
+  std::vector<TemplateOperand> read(const std::vector<int>& shape, const flat::Box& region, sym::Expr e);
+
+ private:
+  const dae::Dae& dae_;
+  const sym::Context& ctx_;
+  const UnknownSymbols& unknowns_;
+  std::vector<int> parameterOf_;  // by symbol id: the parameter, or -1
+  std::vector<char> looked_;      // by array: its base is known
+  std::vector<std::optional<std::pair<int, bool>>> uniform_;  // by array: (variable − linear index, y')
+  std::vector<int> parameters_;   // by array: its first parameter, or -1
 };
 
 /// One entry of a template block's rows: the value (over the block's relative symbols and cj) at

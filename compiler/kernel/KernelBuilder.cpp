@@ -507,7 +507,7 @@ class Builder {
                        static_cast<uint32_t>(op.variable + base + op.offset));
     for (const auto& [t, value] : cse.temporaries) b.bindTemporary(t, value);
     for (Expr t : invariantTemporaries(cse, operands)) b.lower(t);
-    b.beginLoop(loopOver(b, block, base));
+    b.beginLoop(loopOver(b, block.shape, block.region, base));
     if (!jacobian) b.storeLooped(static_cast<uint32_t>(block.firstRow + base), b.lower(cse.outputs[0]));
     for (size_t e = 0; e < entries.size(); ++e) {
       b.storeIndexed(b.appendIndexTable(entries[e]->positions), b.lower(cse.outputs[e]));
@@ -520,14 +520,14 @@ class Builder {
 
   // Row-major points of the region as offsets from its first point: an affine loop in one
   // dimension, a table of offsets in more.
-  static Loop loopOver(ProgramBuilder& b, const dae::TemplateBlock& block, long base) {
+  static Loop loopOver(ProgramBuilder& b, const std::vector<int>& shape, const flat::Box& region, long base) {
     Loop loop;
-    loop.count = static_cast<uint32_t>(flat::pointCount(block.region));
-    if (block.region.size() == 1) return loop;
+    loop.count = static_cast<uint32_t>(flat::pointCount(region));
+    if (region.size() == 1) return loop;
     std::vector<uint32_t> offsets;
     offsets.reserve(loop.count);
-    flat::forEachPoint(block.region, [&](std::span<const long> p, size_t) {
-      offsets.push_back(static_cast<uint32_t>(flat::linearIndex(block.shape, p) - base));
+    flat::forEachPoint(region, [&](std::span<const long> p, size_t) {
+      offsets.push_back(static_cast<uint32_t>(flat::linearIndex(shape, p) - base));
     });
     loop.offsetTable = b.appendIndexTable(offsets);
     return loop;
@@ -553,10 +553,14 @@ class Builder {
     std::string what = block.origin == flat::OriginKind::Kinematic      ? "velocities"
                        : block.origin == flat::OriginKind::EulerLagrange ? "Euler-Lagrange equations"
                                                                         : "equations";
-    std::string region;
-    for (auto [first, last] : block.region)
-      region += (region.empty() ? "" : ", ") + std::to_string(first) + (last > first ? ":" + std::to_string(last) : "");
-    return addSource(what + " of elements [" + region + "] (one loop)", block.range);
+    return addSource(what + " of elements [" + regionText(block.region) + "] (one loop)", block.range);
+  }
+
+  static std::string regionText(const flat::Box& region) {
+    std::string text;
+    for (auto [first, last] : region)
+      text += (text.empty() ? "" : ", ") + std::to_string(first) + (last > first ? ":" + std::to_string(last) : "");
+    return text;
   }
 
   dae::Dae withInitialRows() const {
@@ -567,12 +571,16 @@ class Builder {
 
   // --- outputs and invariants --------------------------------------------------------------------
 
-  Program buildMonitor(ModelProgram program, const std::vector<Expr>& values, const std::vector<uint32_t>& sources) {
+  // out[i] = values[i]; `after` may add to them (an invariant's sums).
+  template <class After = void (*)(ProgramBuilder&)>
+  Program buildMonitor(ModelProgram program, const std::vector<Expr>& values, const std::vector<uint32_t>& sources,
+                       After after = [](ProgramBuilder&) {}) {
     sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, values, "$t");
     ProgramBuilder b(programName(program));
     bindInputs(b, true);
     for (const auto& [t, value] : cse.temporaries) b.bindTemporary(t, value);
     for (uint32_t i = 0; i < values.size(); ++i) b.setSource(sources[i]), b.store(i, b.lower(cse.outputs[i]));
+    after(b);
     reportUnbound(b, programName(program), "declare it as a variable or a parameter");
     return b.finish(static_cast<uint32_t>(values.size()));
   }
@@ -594,7 +602,33 @@ class Builder {
       values.push_back(inv.value);
       sources.push_back(addSource("invariant " + inv.name + " (" + inv.kind + ")", dae_.range));
     }
-    return buildMonitor(ModelProgram::Invariants, values, sources);
+    return buildMonitor(ModelProgram::Invariants, values, sources, [&](ProgramBuilder& b) {
+      LoopOperands operands(dae_, ctx_, unknowns());
+      for (uint32_t i = 0; i < dae_.invariants.size(); ++i)
+        for (size_t k = 0; k < dae_.invariants[i].sums.size(); ++k) emitSum(b, i, k, operands);
+    });
+  }
+
+  // Invariant i's k-th sum: one loop adding its body at every point of its box to out[i] (after
+  // the invariant's scalar part was stored there), with the body's own CSE and its loop-invariant
+  // temporaries computed before the loop.
+  void emitSum(ProgramBuilder& b, uint32_t i, size_t k, LoopOperands& reader) {
+    const dae::Invariant& inv = dae_.invariants[i];
+    const flat::IndexedTerm& sum = inv.sums[k];
+    std::vector<Operand> operands = reader.read(sum.shape, sum.box, sum.body);
+    sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, std::vector<Expr>{sum.body}, "$s" + std::to_string(i) + "_" + std::to_string(k));
+    b.setSource(addSource("invariant " + inv.name + ": sum over [" + regionText(sum.box) + "] (one loop)", dae_.range));
+    std::vector<long> lo;
+    for (auto [first, last] : sum.box) lo.push_back(first);
+    long base = flat::linearIndex(sum.shape, lo);
+    for (const auto& op : operands)
+      b.bindLoopedLoad(op.symbol, op.parameter ? Op::LoadPLooped : op.derivative ? Op::LoadYpLooped : Op::LoadYLooped,
+                       static_cast<uint32_t>(op.variable + base + op.offset));
+    for (const auto& [t, value] : cse.temporaries) b.bindTemporary(t, value);
+    for (Expr t : invariantTemporaries(cse, operands)) b.lower(t);
+    b.beginLoop(loopOver(b, sum.shape, sum.box, base));
+    b.storeAdd(i, b.lower(cse.outputs[0]));
+    b.endLoop();
   }
 };
 

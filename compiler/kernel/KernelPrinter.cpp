@@ -42,7 +42,8 @@ std::string operands(const Instr& ins, const Program& prog, const KernelModule& 
     case bc::Format::Binary: return reg(ins.a) + ", " + reg(ins.b);
     case bc::Format::Ternary: return reg(ins.a) + ", " + reg(ins.b) + ", " + reg(ins.c);
     case bc::Format::UnaryIndex: return reg(ins.a) + ", " + std::to_string(static_cast<int32_t>(ins.imm));
-    case bc::Format::Store: return std::string("out[").append(std::to_string(ins.imm)) + "], " + reg(ins.a);
+    case bc::Format::Store:
+    case bc::Format::StoreAdd: return std::string("out[").append(std::to_string(ins.imm)) + "], " + reg(ins.a);
     case bc::Format::StoreLooped: return std::string("out[").append(std::to_string(ins.imm)) + " + L], " + reg(ins.a);
     case bc::Format::StoreIndexed: return std::string("out[X[").append(std::to_string(ins.imm)) + " + c]], " + reg(ins.a);
     case bc::Format::LoopBegin:

@@ -55,6 +55,8 @@ class ProgramBuilder {
   /// out[slot + L] = reg ; out[indexTable[tableBase + c]] = reg   (inside a loop)
   void storeLooped(uint32_t slot, uint32_t reg) { emit(Op::StoreLooped, reg, 0, 0, slot); }
   void storeIndexed(uint32_t tableBase, uint32_t reg) { emit(Op::StoreIndexed, reg, 0, 0, tableBase); }
+  /// out[slot] += reg  (a sum over a loop's iterations, after out[slot] was stored)
+  void storeAdd(uint32_t slot, uint32_t reg) { emit(Op::StoreAdd, reg, 0, 0, slot); }
   /// Appends to the program's indexTable; returns the base index.
   uint32_t appendIndexTable(std::span<const uint32_t> values);
   /// Room for `count` more indexTable entries (a large model appends millions).

@@ -270,6 +270,11 @@ class PartLowering {
       case Op::Not: return boolean(b_.CreateFCmpOEQ(A(), constant(0.0)));
       case Op::Select: return b_.CreateSelect(isTrue(A()), B(), value(ins.c));
       case Op::Store: b_.CreateStore(A(), elementPtr(kOut, ins.imm, dbl_)); return nullptr;
+      case Op::StoreAdd: {
+        llvm::Value* slot = elementPtr(kOut, ins.imm, dbl_);
+        b_.CreateStore(b_.CreateFAdd(b_.CreateLoad(dbl_, slot), A()), slot);
+        return nullptr;
+      }
       case Op::LoopBegin: beginLoop(ins); return nullptr;
       case Op::LoopEnd: endLoop(ins); return nullptr;
       case Op::LoadYLooped: return b_.CreateLoad(dbl_, loopedPtr(callField(kY), ins.imm));

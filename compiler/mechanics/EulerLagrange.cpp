@@ -319,14 +319,15 @@ class Deriver {
     bool conservative = m_.dissipation.empty() && !statedForces && m_.connectionsConserveEnergy &&
                         !lagrangian_.dependsOnTime;
     for (const auto& c : m_.constraints) conservative &= !ctx_.dependsOn(c.residual, m_.time());
-    out_.jacobiLeftOut = conservative && templated_;
-    conservative &= !templated_;  // Σ v ∂L/∂v over every element: a reduction the kernels do not loop yet
     std::vector<Expr> jacobi;  // Σ v ∂L/∂v, only built when the Jacobi integral exists
     for (const auto& row : out_.rows) {
       if (row.templateRow >= 0) continue;
       const flat::Variable& coord = m_.variables[row.coordinate];
       int v = coord.derivative;
-      if (conservative) jacobi.push_back(ctx_.mul(m_.variables[v].symbol, row.momentum));
+      // A templated model's scalar terms only: a peeled element's momentum has the sums' part too,
+      // which their own loops count (jacobiSums).
+      if (conservative)
+        jacobi.push_back(ctx_.mul(m_.variables[v].symbol, templated_ ? partial(lagrangian_, v) : row.momentum));
       // A peeled element of a templated array is in the templates' sums too (the last mass of a
       // chain: in no scalar term, but in the springs' sum).
       auto found = extras_.find(row.coordinate);
@@ -343,7 +344,49 @@ class Deriver {
     // equations or rigid bodies only): a Jacobi integral would be the constant 0.
     if (!conservative || out_.rows.empty()) return;
     jacobi.push_back(ctx_.neg(ctx_.add(lagrangian_.terms)));
-    out_.integrals.push_back({FirstIntegral::Kind::Jacobi, -1, "jacobi", simplified(ctx_.add(jacobi))});
+    std::vector<flat::IndexedTerm> sums;
+    if (templated_) sums = jacobiSums(jacobi);
+    out_.integrals.push_back({FirstIntegral::Kind::Jacobi, -1, "jacobi", simplified(ctx_.add(jacobi)), std::move(sums)});
+  }
+
+  // The energy sums kept as templates in the Jacobi integral h = Σ v ∂L/∂v − L, which is linear
+  // in L's terms: per sum of T (sign +1) or V (−1) with body b, Σ over its box of
+  // ±(Σ_r r ∂b/∂r − b), r every velocity in b (its own elements' and scalar ones). A body without
+  // relative symbols is the same at every point: its total joins the scalar terms (so do the
+  // points of one that reads arrays of parameters only).
+  std::vector<flat::IndexedTerm> jacobiSums(std::vector<Expr>& scalar) {
+    std::vector<flat::IndexedTerm> sums;
+    for (int s = 0; s < static_cast<int>(m_.indexedSums.size()); ++s) {
+      const flat::IndexedSum& sum = m_.indexedSums[s];
+      if (sum.energy == flat::IndexedSum::Energy::Dissipation ||
+          std::find(scalarSums_.begin(), scalarSums_.end(), s) != scalarSums_.end())
+        continue;
+      std::vector<Expr> parts{ctx_.neg(sum.body)};
+      std::vector<int> shape;
+      bool relative = false;
+      for (Expr r : ctx_.freeSymbols(sum.body)) {
+        VarRole role = VarRole::Parameter;
+        if (const flat::RelativeElement* rel = m_.relativeElement(r)) {
+          relative = true;
+          const flat::ArrayVariable& a = m_.patterns->arrays[rel->array];
+          int var = m_.variableOf(a.elements[0]);
+          if (var >= 0) role = m_.variables[var].role;
+          if (role == VarRole::Coordinate || role == VarRole::Velocity) shape = a.shape;
+        } else if (int var = m_.variableOf(r); var >= 0) {
+          role = m_.variables[var].role;
+        }
+        if (role == VarRole::Velocity) parts.push_back(ctx_.mul(r, ctx_.diff(sum.body, r)));
+      }
+      Expr body = ctx_.scale(sum.energy == flat::IndexedSum::Energy::Kinetic ? 1.0 : -1.0, ctx_.add(parts));
+      if (!shape.empty()) {
+        sums.push_back({sum.box, std::move(shape), simplified(body)});
+      } else if (!relative) {
+        scalar.push_back(ctx_.scale(static_cast<double>(flat::pointCount(sum.box)), body));
+      } else {  // arrays of parameters only: no loop reads them without coordinates (Pipeline.cpp)
+        flat::forEachPoint(sum.box, [&](std::span<const long> p, size_t) { scalar.push_back(flat::instantiate(m_, ctx_, body, p)); });
+      }
+    }
+    return sums;
   }
 };
 

@@ -46,6 +46,9 @@ struct FirstIntegral {
   int coordinate = -1;  ///< CyclicMomentum: the cyclic coordinate
   std::string name;     ///< "p(phi)" or "jacobi"
   sym::Expr value = nullptr;
+  /// Added to `value`: sums over every element of coordinate arrays (the Jacobi integral of a
+  /// templated model: one per energy sum), computed by loops.
+  std::vector<flat::IndexedTerm> sums;
 };
 
 struct EquationsOfMotion {
@@ -55,15 +58,12 @@ struct EquationsOfMotion {
   std::vector<TemplateRow> templateRows;
   std::vector<Multiplier> multipliers;
   std::vector<FirstIntegral> integrals;
-  /// The system is conservative, but its rows are templates: the Jacobi integral, a sum over
-  /// every element, is not among `integrals` (the kernels do not loop reductions yet).
-  bool jacobiLeftOut = false;
   sym::Expr kinetic = nullptr, potential = nullptr, dissipation = nullptr;  ///< totals T, V, D
 };
 
 /// Derives the rows; with IndexedSums in the model (flattened with FlattenLimits::keepLoops), the
 /// rows of coordinate arrays per region as templates and the peeled elements' rows as scalars, and
-/// no Jacobi integral (it would be a sum over every element). Reports located errors (E04xx) and returns nullopt on failure. At `simplify`
+/// the Jacobi integral as scalar terms plus one sum per energy sum (FirstIntegral::sums). Reports located errors (E04xx) and returns nullopt on failure. At `simplify`
 /// (sym/Simplify.h) the energies are simplified before they are differentiated (so cyclic
 /// coordinates and time-independence are judged on the simplified Lagrangian), and the rows, the
 /// momenta and the first integrals after.

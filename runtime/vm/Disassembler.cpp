@@ -35,7 +35,8 @@ std::string operandText(const bc::Module& m, const bc::Function& f, const uint32
     case bc::Format::Binary: return reg(o[0]) + ", " + reg(o[1]) + ", " + reg(o[2]);
     case bc::Format::Ternary: return reg(o[0]) + ", " + reg(o[1]) + ", " + reg(o[2]) + ", " + reg(o[3]);
     case bc::Format::UnaryIndex: return reg(o[0]) + ", " + reg(o[1]) + ", " + std::to_string(static_cast<int32_t>(o[2]));
-    case bc::Format::Store: return std::string("out[").append(std::to_string(o[0])) + "], " + reg(o[1]);
+    case bc::Format::Store:
+    case bc::Format::StoreAdd: return std::string("out[").append(std::to_string(o[0])) + "], " + reg(o[1]);
     case bc::Format::StoreLooped: return std::string("out[").append(std::to_string(o[0])) + " + L], " + reg(o[1]);
     case bc::Format::StoreIndexed: return std::string("out[X[").append(std::to_string(o[0])) + " + c]], " + reg(o[1]);
     case bc::Format::LoopBegin: {

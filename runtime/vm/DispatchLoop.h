@@ -22,6 +22,7 @@
 #define QDOT_VM_Store(E) { const double A = r[ip[2]]; out[ip[1]] = (E); ip += 3; }
 #define QDOT_VM_StoreLooped(E) { const double A = r[ip[2]]; out[ip[1] + L] = (E); ip += 3; }
 #define QDOT_VM_StoreIndexed(E) { const double A = r[ip[2]]; out[X[ip[1] + c]] = (E); ip += 3; }
+#define QDOT_VM_StoreAdd(E) { const double A = r[ip[2]]; out[ip[1]] += (E); ip += 3; }
 #define QDOT_VM_LoopBegin(E) \
   { loop = &loops[ip[1]], c = 0; if (loop->count == 0) ip += ip[2]; else L = loop->offset(0, X), ip += 3, body = ip; }
 #define QDOT_VM_LoopEnd(E) { if (++c < loop->count) L = loop->offset(c, X), ip = body; else ip += 2; }

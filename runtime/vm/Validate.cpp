@@ -102,7 +102,7 @@ class FunctionChecker {
     bool ok = !definesRegister(f) || dst(ins.dest);
     for (uint32_t i = 0; i < readCount(f); ++i) ok = ok && src(reads[i]);
     if (f == Format::Index) ok = ok && indexOk(ins.op, ins.imm);
-    if (f == Format::Store) ok = ok && ins.imm < f_.outputCount;
+    if (f == Format::Store || f == Format::StoreAdd) ok = ok && ins.imm < f_.outputCount;
     return ok ? "" : std::string("operand out of range in ") + info(ins.op).mnemonic;
   }
 

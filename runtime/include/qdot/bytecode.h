@@ -39,6 +39,7 @@ enum class Opcode : uint8_t {
   X(Store, 2, 1)                    \
   X(StoreLooped, 2, 1)              \
   X(StoreIndexed, 2, 1)             \
+  X(StoreAdd, 2, 1)                 \
   X(LoopBegin, 2, 0)                \
   X(LoopEnd, 1, 0)
 
@@ -69,9 +70,9 @@ inline constexpr uint32_t readCount(Format f) {
   return reads[static_cast<uint8_t>(f)];
 }
 
-/// True for the formats writing out[] (st, stl, stx).
+/// True for the formats writing out[] (st, stl, stx, stadd).
 inline constexpr bool isStore(Format f) {
-  return f == Format::Store || f == Format::StoreLooped || f == Format::StoreIndexed;
+  return f == Format::Store || f == Format::StoreLooped || f == Format::StoreIndexed || f == Format::StoreAdd;
 }
 /// True for `loop` and `endloop`.
 inline constexpr bool isLoopControl(Format f) { return f == Format::LoopBegin || f == Format::LoopEnd; }

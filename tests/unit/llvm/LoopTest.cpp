@@ -3,7 +3,7 @@
 // values from before a loop cross parts) give the same bits as the direct C++ computation — an
 // affine stencil with peeled ends and invariant registers, count 0 and 1, a table loop storing
 // through a permutation (stx) with ldidx, negative strides, a value from before a loop used after
-// it, a parameter array read with ldpl. A NaN inside a loop is named with its iteration on the VM
+// it, a parameter array read with ldpl, a sum over a loop (stadd). A NaN inside a loop is named with its iteration on the VM
 // and on the JIT.
 #include <cstdio>
 #include <functional>
@@ -172,6 +172,27 @@ TEST(Loops, NegativeStrideAndTwoLoopsOnEveryBackend) {
   expectEveryBackend(w.p, n, [&](const double* y, const double* yp, double, double* F) {
     for (uint32_t L = n - 1; L >= 3; --L) F[L] = 0.01 * double(L) + yp[L];
     for (uint32_t L = 0; L < 3; ++L) F[L] = 0.01 * y[L];
+  });
+}
+
+// A sum over a loop (stadd, an invariant's Σ over every element): out[0] = y[0]² + Σ_L y[L]·yp[L]
+// for L = 1 .. n-2 (added in order), out[n-1] = k after it, the other slots 0.
+TEST(Loops, ASumOverALoopOnEveryBackend) {
+  const uint32_t n = 9;
+  Writer w;
+  uint32_t y0 = w.op(Op::LoadY);
+  w.op(Op::Store, w.op(Op::Mul, y0, y0), 0, 0, 0);
+  w.loop(Loop{.count = n - 2, .first = 1, .stride = 1});
+  w.op(Op::StoreAdd, w.op(Op::Mul, w.op(Op::LoadYLooped), w.op(Op::LoadYpLooped)), 0, 0, 0);
+  w.endLoop();
+  uint32_t zero = w.k(0.0);
+  for (uint32_t i = 1; i + 1 < n; ++i) w.op(Op::Store, zero, 0, 0, i);
+  w.op(Op::Store, w.op(Op::LoadP), 0, 0, n - 1);
+  expectEveryBackend(w.p, n, [&](const double* y, const double* yp, double kv, double* F) {
+    F[0] = y[0] * y[0];
+    for (uint32_t L = 1; L + 1 < n; ++L) F[0] += y[L] * yp[L];
+    for (uint32_t i = 1; i + 1 < n; ++i) F[i] = 0.0;
+    F[n - 1] = kv;
   });
 }
 

@@ -38,6 +38,7 @@ kernel::KernelModule opcodeModule() {
   results.push_back(add(Op::Select, x, y, z));
   results.push_back(add(Op::Select, z, x, y));
   for (uint32_t i = 0; i < results.size(); ++i) add(Op::Store, results[i], 0, 0, i);
+  add(Op::StoreAdd, results[6], 0, 0, 0);  // out[0] = t + (x + y)
   res.outputCount = static_cast<uint32_t>(results.size());
 
   kernel::KernelModule m;

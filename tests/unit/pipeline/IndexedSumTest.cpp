@@ -206,16 +206,18 @@ TEST(TemplateRows, ChainInteriorIsOneTemplateAndEqualsTheScalarRows) {
 // First integrals with templates. Reference: the scalar derivation of the same model. The free end
 // x[n] of the undamped chain is in no scalar term but in the springs' sum: not cyclic (its momentum
 // changes whenever the last spring is stretched), which the templated derivation once missed; the
-// free particle z is cyclic in both. The Jacobi integral, a sum over every element, is left out with
-// templates, and the derivation says so.
-TEST(TemplateRows, FirstIntegralsAreThoseOfTheScalarDerivationButTheJacobiIntegral) {
+// free particle z is cyclic in both. The Jacobi integral of a natural system is T + V: with
+// templates its scalar part plus its sums (one per energy sum) at every point, evaluated at random
+// values of every symbol, equals T + V of the scalar model.
+TEST(TemplateRows, FirstIntegralsAreThoseOfTheScalarDerivationWithTheJacobiIntegralAsSums) {
   test::SourceDae s("undamped.qd", R"(model Undamped
   parameter Integer n = 6;
+  parameter Real m[n] = {1 + 0.1*i for i in 1:n};
   coordinate Real x[n](start = {0.01*i for i in 1:n});
   coordinate Real z(start = 0);
 mechanics
-  kinetic = sum(0.5*der(x[i])^2 for i in 1:n) + 0.5*der(z)^2;
-  potential = 0.5*100*x[1]^2 + sum(0.5*100*(x[i+1] - x[i])^2 for i in 1:n-1);
+  kinetic = sum(0.5*m[i]*der(x[i])^2 for i in 1:n) + 0.5*der(z)^2 + 0.25*der(z)*der(x[3]);
+  potential = 0.5*100*x[1]^2 + sum(0.5*100*(x[i+1] - x[i])^2 + 3*x[i]^4 for i in 1:n-1);
 end Undamped;
 )", driver::Stage::Check);
   Flattened f = flattenBoth(s);
@@ -229,10 +231,43 @@ end Undamped;
     for (const auto& i : e.integrals) out.push_back(i.name);
     return out;
   };
-  EXPECT_EQ(names(*scalar), (std::vector<std::string>{"p(z)", "jacobi"}));
-  EXPECT_EQ(names(*templated), (std::vector<std::string>{"p(z)"}));
-  EXPECT_FALSE(scalar->jacobiLeftOut);
-  EXPECT_TRUE(templated->jacobiLeftOut);
+  EXPECT_EQ(names(*scalar), (std::vector<std::string>{"p(z)", "jacobi"}));  // p(z) = ż + ẋ₃/4
+  ASSERT_EQ(names(*templated), names(*scalar));
+  const mech::FirstIntegral& h = templated->integrals.back();
+  EXPECT_EQ(h.sums.size(), 2u);  // the kinetic sum and the potential sum
+  std::vector<sym::Expr> terms{h.value};
+  for (const flat::IndexedTerm& sum : h.sums)
+    flat::forEachPoint(sum.box, [&](std::span<const long> p, size_t) { terms.push_back(flat::instantiate(*f.templated, s.ctx, sum.body, p)); });
+  sym::Expr total = s.ctx.add(terms);
+  std::vector<double> values(s.ctx.symbolCount());
+  for (size_t i = 0; i < values.size(); ++i) values[i] = 0.3 + 0.7 * std::sin(1.0 + 1.7 * static_cast<double>(i));
+  double energy = sym::evaluate(s.ctx.add(scalar->kinetic, scalar->potential), values);
+  EXPECT_NEAR(sym::evaluate(scalar->integrals.back().value, values), energy, 1e-12 * std::abs(energy));
+  EXPECT_NEAR(sym::evaluate(total, values), energy, 1e-12 * std::abs(energy));
+  EXPECT_NEAR(sym::evaluate(templated->integrals[0].value, values), sym::evaluate(scalar->integrals[0].value, values), 1e-14);
+}
+
+// The cyclic coordinate of a chain with a free particle: its momentum with templates as without.
+TEST(TemplateRows, CyclicMomentaAreThoseOfTheScalarDerivation) {
+  test::SourceDae s("free.qd", R"(model Free
+  parameter Integer n = 6;
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+  coordinate Real z(start = 0);
+mechanics
+  kinetic = sum(0.5*der(x[i])^2 for i in 1:n) + 0.5*der(z)^2;
+  potential = 0.5*100*x[1]^2 + sum(0.5*100*(x[i+1] - x[i])^2 for i in 1:n-1);
+end Free;
+)", driver::Stage::Check);
+  Flattened f = flattenBoth(s);
+  ASSERT_TRUE(f.scalar && f.templated);
+  auto scalar = mech::deriveEquationsOfMotion(*f.scalar, s.ctx, s.diags);
+  auto templated = mech::deriveEquationsOfMotion(*f.templated, s.ctx, s.diags);
+  ASSERT_TRUE(scalar && templated);
+  std::vector<std::string> names;
+  for (const auto& i : templated->integrals) names.push_back(i.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"p(z)", "jacobi"}));
+  EXPECT_EQ(scalar->integrals.size(), 2u);
+  EXPECT_EQ(templated->integrals[0].value, scalar->integrals[0].value);
 }
 
 TEST(TemplateRows, GridOfMassesHasItsInteriorAndEdgesAsTemplates) {

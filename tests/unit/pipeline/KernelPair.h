@@ -1,5 +1,5 @@
 // Test helper for comparing a model's looped and scalar kernels (issue 15): the model compiled to
-// kernels with or without templates, and its residual and Jacobian on the reference interpreter
+// kernels with or without templates, and its residual, Jacobian and invariants on the reference interpreter
 // at a reproducible state per trial.
 #pragma once
 
@@ -44,12 +44,12 @@ inline size_t loopCount(const kernel::Program& p) { return opCount(p, kernel::Op
 /// Parameter values given at run time (as `qdot run -p name=value` gives them), by name.
 using GivenParameters = std::vector<std::pair<std::string, double>>;
 
-/// The residual F and the Jacobian's values J (CSC order) of a kernel module.
+/// The residual F, the Jacobian's values J (CSC order) and the invariants of a kernel module.
 struct KernelValues {
-  std::vector<double> F, J;
+  std::vector<double> F, J, invariants;
 };
 
-/// F and J at trial state `trial` (y, y', cj and t fixed by it), with the default parameter values
+/// F, J and the invariants at trial state `trial` (y, y', cj and t fixed by it), with the default parameter values
 /// except those `given`.
 inline KernelValues evaluateAt(const kernel::KernelModule& k, int trial, const GivenParameters& givenValues = {}) {
   size_t n = k.variableCount(), nnz = k.description.jacobianRowIndices.size();
@@ -70,9 +70,10 @@ inline KernelValues evaluateAt(const kernel::KernelModule& k, int trial, const G
     yp[j] = 0.2 * std::cos(0.7 * j + 2 * trial);
   }
   ModelCall in{.t = 0.3, .cj = 17.0 + trial, .y = y.data(), .yp = yp.data(), .p = p.data()};
-  KernelValues v{std::vector<double>(n), std::vector<double>(nnz)};
+  KernelValues v{std::vector<double>(n), std::vector<double>(nnz), std::vector<double>(k.description.invariantNames.size())};
   kernel::interpret(k.program(ModelProgram::Residual), in, v.F);
   kernel::interpret(k.program(ModelProgram::Jacobian), in, v.J);
+  kernel::interpret(k.program(ModelProgram::Invariants), in, v.invariants);
   return v;
 }
 

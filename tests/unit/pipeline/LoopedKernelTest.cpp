@@ -1,7 +1,8 @@
 // Looped and scalar kernels compute the same model (issue 15): a model compiled with its repeated
 // structure kept as templates (CompileOptions::keepLoops: loops in the residual and Jacobian) and
 // the same model compiled element by element give the same residual and the same Jacobian (same
-// CSC pattern, values equal to rounding) at random states, on the reference interpreter.
+// CSC pattern, values equal to rounding) and the same invariants at random states, on the
+// reference interpreter.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -35,6 +36,49 @@ size_t expectSameKernels(const std::string& text, const test::GivenParameters& g
   }
   EXPECT_EQ(loopCount(a.program(ModelProgram::Residual)), 0u);
   return loopCount(b.program(ModelProgram::Residual));
+}
+
+// The invariants of a conservative model: its Jacobi integral with the energy sums as loops
+// (stadd) equals the scalar one, whose value the mechanics tests check against T + V.
+void expectSameInvariants(const std::string& text, size_t sums) {
+  Compiled scalar(text, false), looped(text, true);
+  const kernel::KernelModule &a = scalar.kernels(), &b = looped.kernels();
+  EXPECT_EQ(a.description.invariantNames, b.description.invariantNames);
+  ASSERT_FALSE(a.description.invariantNames.empty());
+  EXPECT_EQ(a.description.invariantNames.back(), "jacobi");
+  for (int trial = 0; trial < 3; ++trial) {
+    std::vector<double> va = test::evaluateAt(a, trial).invariants, vb = test::evaluateAt(b, trial).invariants;
+    for (size_t i = 0; i < va.size(); ++i) EXPECT_NEAR(vb[i], va[i], 1e-13 * (1 + std::abs(va[i]))) << "invariant " << i;
+  }
+  EXPECT_EQ(loopCount(a.program(ModelProgram::Invariants)), 0u);
+  EXPECT_EQ(loopCount(b.program(ModelProgram::Invariants)), sums);
+  EXPECT_EQ(test::opCount(b.program(ModelProgram::Invariants), kernel::Op::StoreAdd), sums);
+}
+
+TEST(LoopedKernels, JacobiIntegralOfAChainIsTheScalarOneWithItsSumsAsLoops) {
+  expectSameInvariants(R"(model Chain
+  parameter Integer n = 9;
+  parameter Real m[n] = {1 + 0.5*sin(i) for i in 1:n}, k = 1000;
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+  coordinate Real z(start = 0.1);
+mechanics
+  kinetic = sum(0.5*m[i]*der(x[i])^2 for i in 1:n) + 0.5*der(z)^2;
+  potential = 0.5*k*x[1]^2 + sum(0.5*k*(x[i+1] - x[i])^2 + k*(1 - cos(x[i])) for i in 1:n-1);
+end Chain;
+)", 2);
+}
+
+TEST(LoopedKernels, JacobiIntegralOfAGridIsTheScalarOneWithItsSumsAsLoops) {
+  expectSameInvariants(R"(model Grid
+  parameter Integer n = 6, m = 5;
+  parameter Real k = 10, mass[n, m] = {{1 + 0.1*i*j for j in 1:m} for i in 1:n};
+  coordinate Real z[n, m](start = {{0.01*i*j for j in 1:m} for i in 1:n});
+mechanics
+  kinetic = sum(0.5*mass[i, j]*der(z[i, j])^2 for i in 1:n, j in 1:m);
+  potential = sum(0.5*k*(z[i+1, j] - z[i, j])^2 for i in 1:n-1, j in 1:m)
+            + sum(0.5*k*(z[i, j+1] - z[i, j])^2 + 0.1*k*z[i, j]^4 for i in 1:n, j in 1:m-1);
+end Grid;
+)", 3);
 }
 
 TEST(LoopedKernels, SpringChainGivesTheScalarResidualAndJacobian) {

@@ -33,7 +33,8 @@ TEST(OpcodeTable, MnemonicsAreUniqueAndMapBack) {
 
 // A residual-like function using every opcode once, inside a loop of one iteration (offset 0) so
 // that the looped opcodes are allowed: registers 0..2 are constants, the loads fill the next ones,
-// and every computing opcode stores its result in out[k]; stl and stx store the last one again.
+// and every computing opcode stores its result in out[k]; stl and stx store the last one again, and
+// stadd adds it to out[0].
 struct EveryOpcode {
   bc::Module module = tinyModule();
   uint32_t outputs = 0;
@@ -50,6 +51,7 @@ struct EveryOpcode {
       switch (bc::info(op).format) {
         case bc::Format::End:
         case bc::Format::Store:
+        case bc::Format::StoreAdd:
         case bc::Format::StoreLooped:
         case bc::Format::StoreIndexed:
         case bc::Format::LoopBegin:
@@ -64,7 +66,7 @@ struct EveryOpcode {
       a.op(Opcode::Store, {outputs++, d});
     }
     f.indexTable = {outputs + 1};
-    a.op(Opcode::StoreLooped, {outputs, next - 1}).op(Opcode::StoreIndexed, {0, next - 1});
+    a.op(Opcode::StoreLooped, {outputs, next - 1}).op(Opcode::StoreIndexed, {0, next - 1}).op(Opcode::StoreAdd, {0, next - 1});
     a.op(Opcode::LoopEnd, {0});
     f.code[2] = static_cast<uint32_t>(f.code.size());  // the loop's exit: after its endloop
     outputs += 2;
@@ -136,6 +138,22 @@ TEST(Semantics, EdgeCases) {
   EXPECT_EQ(apply(Opcode::Ne, 1, 1), 0);
   EXPECT_EQ(apply(Opcode::Atan2, 1, -1), std::atan2(1.0, -1.0));
   EXPECT_TRUE(std::isnan(apply(Opcode::Sqrt, -1)));
+}
+
+// stadd adds to what the slot holds: a sum over a loop's iterations, started by a `st`.
+TEST(Semantics, StoreAddSumsOverALoop) {
+  bc::Module m = tinyModule();
+  bc::Function& f = m.function(ModelProgram::Jacobian);
+  Assembler a(f, {0.5}, 2);
+  f.loops = {Loop{.count = 4, .first = 0, .stride = 1}};
+  a.op(Opcode::Store, {0, 0}).op(Opcode::LoopBegin, {0, 0});
+  size_t loopWord = f.code.size() - 3;
+  a.op(Opcode::LoadLoopOffset, {a.r(0)}).op(Opcode::StoreAdd, {0, a.r(0)}).op(Opcode::LoopEnd, {0});
+  f.code[loopWord + 2] = static_cast<uint32_t>(f.code.size() - loopWord);
+  a.ret(1);
+  std::vector<double> r = vm::makeRegisters(f), out(1, -7.0);
+  vm::execute(f, r.data(), {}, out.data());
+  EXPECT_EQ(out[0], 0.5 + 0 + 1 + 2 + 3);
 }
 
 }  // namespace
