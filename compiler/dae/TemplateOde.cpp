@@ -54,7 +54,7 @@ bool isAlgebraic(const flat::FlatModel& m, int v) {
 
 bool onlyEquations(const flat::FlatModel& m) {
   return m.indexedSums.empty() && m.kinetic.empty() && m.potential.empty() && m.dissipation.empty() &&
-         m.forces.empty() && m.constraints.empty() && m.initialEquations.empty() && m.components.size() <= 1;
+         m.forces.empty() && m.constraints.empty() && m.components.size() <= 1;
 }
 
 // The derivative symbols of a row (scalar variables or relative symbols of arrays of derivatives)
@@ -175,8 +175,28 @@ class OdeCheck {
 
 }  // namespace
 
+bool initialEquationsAreStartValues(const flat::FlatModel& m, const sym::Context& ctx) {
+  auto isState = [&](Expr s) {
+    int v = m.variableOf(s);
+    if (v < 0 || m.variables[v].alias) return false;
+    VarRole r = m.variables[v].role;
+    return r == VarRole::Coordinate || r == VarRole::Velocity || (r == VarRole::Unknown && m.variables[v].derivative >= 0);
+  };
+  auto overParameters = [&](Expr e) {
+    for (Expr s : ctx.freeSymbols(e))
+      if (int v = m.variableOf(s); v < 0 || (m.variables[v].role != VarRole::Parameter && m.variables[v].role != VarRole::Time))
+        return false;
+    return true;
+  };
+  return std::all_of(m.initialEquations.begin(), m.initialEquations.end(), [&](const flat::Equation& e) {
+    return e.lhs && e.rhs && ((isState(e.lhs) && overParameters(e.rhs)) || (isState(e.rhs) && overParameters(e.lhs)));
+  });
+}
+
 bool isTemplatedOde(const flat::FlatModel& m, const sym::Context& ctx) {
-  if (m.equationTemplates.empty() || !onlyEquations(m) || !onlyUnknownsAndParameters(m)) return false;
+  if (m.equationTemplates.empty() || !onlyEquations(m) || !onlyUnknownsAndParameters(m) ||
+      !initialEquationsAreStartValues(m, ctx))
+    return false;
   std::vector<int> rows(m.variables.size(), 0);  // per unknown: the rows matched to it
   OdeCheck check(m, ctx);
   for (const flat::Equation& e : m.equations) {
@@ -230,6 +250,7 @@ void addTemplatedOde(const flat::FlatModel& m, sym::Context& ctx, Dae& dae) {
     });
   }
   for (char p : placed) QDOT_ASSERT(p, "a row of a templated ODE without an equation");
+  dae.initialEquations = m.initialEquations;  // start values (initialEquationsAreStartValues)
   dae.patterns = m.patterns;
 }
 

@@ -92,10 +92,12 @@ bool loopsReadSum(const flat::FlatModel& m, const flat::IndexedSum& sum, const s
 
 // Where the stages after flattening take templates (docs/loops.md): a model of energies over
 // coordinates only — no equations, constraints, components or aliases (their structural passes
-// work on scalars). Its Jacobi integral is a sum over every element: the kernels loop it too.
+// work on scalars), initial equations that are start values at most. Its Jacobi integral is a
+// sum over every element: the kernels loop it too.
 bool templatesApply(const flat::FlatModel& m, const CompileOptions& o, const sym::Context& ctx) {
   if (!o.keepLoops || m.indexedSums.empty()) return false;
-  if (!m.equations.empty() || !m.initialEquations.empty() || !m.constraints.empty() || m.components.size() > 1) return false;
+  if (!m.equations.empty() || !m.constraints.empty() || m.components.size() > 1) return false;
+  if (!dae::initialEquationsAreStartValues(m, ctx)) return false;
   bool plain = std::none_of(m.variables.begin(), m.variables.end(), [](const flat::Variable& v) {
     return v.alias || v.role == flat::VarRole::Unknown || v.role == flat::VarRole::Derivative;
   });
@@ -112,15 +114,14 @@ void returnFreedMemory() {
 }
 
 // Whether `for` equations may stay templates (docs/loops.md), from the syntax: a run that keeps
-// loops and needs no invariants, of a model of equations only — no mechanics, initial equations or
-// components — with `for` loops of equations naming at most one derivative each (`der(x[i]) = …`,
+// loops and needs no invariants, of a model of equations only — no mechanics or components (initial
+// equations that are start values are checked on the flat model) — with `for` loops of equations naming at most one derivative each (`der(x[i]) = …`,
 // `m*der(v[i]) = …`, `f[i] = …`; flat::mayKeepForEquation), one of them naming some. Flattening
 // then keeps them only if each row is matched to its own unknown (dae::isTemplatedOde), else it
 // flattens again.
 bool forEquationsMayStay(const Compilation& c) {
   const sema::CheckedClass& root = *c.checked->root;
-  if (!c.options.keepLoops || c.options.keepInvariants || !root.mechanics.empty() || !root.initialEquations.empty())
-    return false;
+  if (!c.options.keepLoops || c.options.keepInvariants || !root.mechanics.empty()) return false;
   for (const auto& [name, symbol] : root.symbols)
     if (symbol.kind == sema::SymbolKind::Component) return false;
   auto keepable = [](const ast::Equation* eq) { return eq->kind == ast::EquationKind::For && flat::mayKeepForEquation(*eq); };

@@ -247,31 +247,40 @@ class Builder {
     std::vector<uint32_t> sources;  ///< per variable: the source of its value (UINT32_MAX: none)
   };
 
-  bool overParameters(Expr e) const {
-    for (Expr s : ctx_.freeSymbols(e)) {
-      bool ok = s == dae_.time;
-      for (const auto& p : dae_.parameters) ok = ok || p.symbol == s;
-      if (!ok) return false;
-    }
+  // By symbol id, whether it is a parameter (built on first use: a model may have an initial
+  // equation per element, each looked up here).
+  bool isParameter(Expr s) {
+    if (parameterSymbol_.empty() && !dae_.parameters.empty())
+      for (const auto& p : dae_.parameters) {
+        if (parameterSymbol_.size() <= p.symbol->symbolId) parameterSymbol_.resize(p.symbol->symbolId + 1, 0);
+        parameterSymbol_[p.symbol->symbolId] = 1;
+      }
+    return s->symbolId < parameterSymbol_.size() && parameterSymbol_[s->symbolId];
+  }
+  std::vector<char> parameterSymbol_;
+
+  bool overParameters(Expr e) {
+    for (Expr s : ctx_.freeSymbols(e))
+      if (s != dae_.time && !isParameter(s)) return false;
     return true;
   }
 
-  // `v = expr` or `der(x) = expr` (either side) with expr over parameters and time.
+  // `v = expr` (either side) with expr over parameters and time: v's start value. (The value of
+  // a derivative, `der(x) = expr`, is a condition of the initialization system.)
   bool applyInitialEquation(size_t i, Starts& starts) {
     const dae::Equation& e = dae_.initialEquations[i];
     if (!e.lhs || !e.rhs) return false;
     for (int side = 0; side < 2; ++side) {
       Expr target = side ? e.rhs : e.lhs, value = side ? e.lhs : e.rhs;
       if (!target->isSymbol() || !overParameters(value)) continue;
-      for (size_t j = 0; j < dae_.variables.size(); ++j) {
-        const auto& v = dae_.variables[j];
-        if (v.y != target) continue;  // a derivative's value is a condition of the initialization system
-        if (!acceptInitialEquation(e, i, j, true)) return true;  // reported
-        uint32_t src = addSource("initial equation " + std::to_string(i + 1), e.origin.range, equationText(e));
-        starts.values[j] = value, starts.sources[j] = src, m_.description.fixed[j] = kFixedAsWritten;
-        startUse_[j] = dae::StartUse::Required;
-        return true;
-      }
+      std::optional<UnknownSymbols::Unknown> u = unknowns().find(target);
+      if (!u || u->derivative) continue;
+      size_t j = u->variable;
+      if (!acceptInitialEquation(e, i, j, true)) return true;  // reported
+      uint32_t src = addSource("initial equation " + std::to_string(i + 1), e.origin.range, equationText(e));
+      starts.values[j] = value, starts.sources[j] = src, m_.description.fixed[j] = kFixedAsWritten;
+      startUse_[j] = dae::StartUse::Required;
+      return true;
     }
     return false;
   }

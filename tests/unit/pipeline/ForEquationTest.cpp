@@ -67,6 +67,7 @@ size_t expectSameKernels(const std::string& text, size_t blocks, const test::Giv
     test::KernelValues A = test::evaluateAt(a, trial, given), B = test::evaluateAt(b, trial, given);
     const std::vector<double>&fa = A.F, &fb = B.F, &va = A.J, &vb = B.J;
     for (size_t i = 0; i < n; ++i) EXPECT_NEAR(fb[row[i]], fa[i], 1e-13 * (1 + std::abs(fa[i]))) << "F[" << i << "]";
+    EXPECT_EQ(A.start, B.start);  // start values, initial equations included
     for (const auto& [at, k] : ja) {
       auto other = jb.find(at);
       if (other == jb.end()) {
@@ -238,6 +239,32 @@ void expectScalarFallback(const std::string& text) {
   kernel::printKernels(b, looped.kernels());
   EXPECT_EQ(a.str(), b.str());
   EXPECT_EQ(loopCount(looped.kernels().program(ModelProgram::Residual)), 0u);
+}
+
+// Initial equations that give states their start values (`T[1] = …`, also in a loop) keep the
+// templates, with the same start values and fixed flags; one that is a condition on a derivative
+// is a row of the initialization system, which the structural passes solve on scalars.
+TEST(ForEquations, InitialEquationsThatAreStartValuesKeepTheLoop) {
+  std::string rod = kRod;
+  rod.replace(rod.find("end Rod;"), 8, R"(initial equation
+  T[1] = 2*a;
+  for i in 2:4 loop
+    a*i = T[i];
+  end for;
+end Rod;)");
+  EXPECT_EQ(expectSameKernels(rod, 1), 1u);
+  Compiled looped(rod, true);
+  ASSERT_TRUE(looped.ok);
+  test::KernelValues v = test::evaluateAt(looped.kernels(), 0);
+  EXPECT_EQ(v.start[0], 2 * 1.7);
+  EXPECT_EQ(v.start[3], 1.7 * 4);
+  EXPECT_EQ(looped.kernels().description.fixed[3], kFixedAsWritten);
+}
+
+TEST(ForEquations, AnInitialEquationOnADerivativeKeepsTheModelScalar) {
+  std::string rod = kRod;
+  rod.replace(rod.find("end Rod;"), 8, "initial equation\n  der(T[1]) = 0;\nend Rod;");
+  expectScalarFallback(rod);
 }
 
 // A parameter array a loop cannot address (another shape than the plate's, iterators out of order)

@@ -44,9 +44,10 @@ inline size_t loopCount(const kernel::Program& p) { return opCount(p, kernel::Op
 /// Parameter values given at run time (as `qdot run -p name=value` gives them), by name.
 using GivenParameters = std::vector<std::pair<std::string, double>>;
 
-/// The residual F, the Jacobian's values J (CSC order) and the invariants of a kernel module.
+/// The residual F, the Jacobian's values J (CSC order), the invariants and the initial values
+/// (y0, y'0, nominal) of a kernel module.
 struct KernelValues {
-  std::vector<double> F, J, invariants;
+  std::vector<double> F, J, invariants, start;
 };
 
 /// F, J and the invariants at trial state `trial` (y, y', cj and t fixed by it), with the default parameter values
@@ -74,6 +75,8 @@ inline KernelValues evaluateAt(const kernel::KernelModule& k, int trial, const G
   kernel::interpret(k.program(ModelProgram::Residual), in, v.F);
   kernel::interpret(k.program(ModelProgram::Jacobian), in, v.J);
   kernel::interpret(k.program(ModelProgram::Invariants), in, v.invariants);
+  v.start.resize(3 * n);
+  kernel::interpret(k.program(ModelProgram::InitialValues), ModelCall{.t = 0.0, .p = p.data()}, v.start);
   return v;
 }
 

@@ -81,6 +81,36 @@ end Grid;
 )", 3);
 }
 
+// Initial equations that are start values (a coordinate's, a velocity's) keep the loops, with the
+// start values of the scalar kernels; one that is not keeps the model scalar.
+TEST(LoopedKernels, InitialEquationsThatAreStartValuesKeepTheLoops) {
+  std::string chain = R"(model Chain
+  parameter Integer n = 9;
+  parameter Real k = 1000, v0 = 0.3;
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+mechanics
+  kinetic = sum(0.5*der(x[i])^2 for i in 1:n);
+  potential = 0.5*k*x[1]^2 + sum(0.5*k*(x[i+1] - x[i])^2 for i in 1:n-1);
+initial equation
+  der(x[n]) = v0;
+  for i in 2:3 loop
+    x[i] = 0.1*i;
+  end for;
+end Chain;
+)";
+  EXPECT_EQ(expectSameKernels(chain), 2u);
+  Compiled scalar(chain, false), looped(chain, true);
+  test::KernelValues a = test::evaluateAt(scalar.kernels(), 0), b = test::evaluateAt(looped.kernels(), 0);
+  EXPECT_EQ(a.start, b.start);
+  EXPECT_EQ(b.start[2], 0.1 * 3);
+  EXPECT_EQ(b.start[17], 0.3);  // der(x[9])
+  EXPECT_EQ(scalar.kernels().description.fixed, looped.kernels().description.fixed);
+  chain.replace(chain.find("der(x[n]) = v0"), 14, "der(x[n]) = x[1]");
+  Compiled implicit(chain, true);
+  ASSERT_TRUE(implicit.ok) << implicit.diagnostics();
+  EXPECT_FALSE(implicit.c.dae->templated());
+}
+
 TEST(LoopedKernels, SpringChainGivesTheScalarResidualAndJacobian) {
   size_t loops = expectSameKernels(R"(model Chain
   parameter Integer n = 9;
