@@ -66,13 +66,14 @@ bool check(Compilation& c) {
   return c.checked && !c.diags.hasErrors();
 }
 
-// Whether every relative symbol of the sum is one the loops read: an array of coordinates or
-// velocities, or an array of parameters a loop addresses as p[first + linear index]
-// (flat::loopableParameters; in several dimensions of the shape of the coordinates the sum reads).
-bool loopsReadSum(const flat::FlatModel& m, const flat::IndexedSum& sum, const sym::Context& ctx) {
+// Whether every relative symbol of a template's body is one the loops read: an array of
+// coordinates or velocities, or an array of parameters a loop addresses as p[first + linear index]
+// (flat::loopableParameters; in several dimensions of the shape of the coordinates the template
+// reads). `shape`: the coordinates' shape if known (a force's target), else null.
+bool loopsRead(const flat::FlatModel& m, sym::Expr body, size_t rank, const std::vector<int>* shape,
+               const sym::Context& ctx) {
   std::vector<const flat::RelativeElement*> parameters;
-  const std::vector<int>* shape = nullptr;  // of the sum's moving arrays
-  for (sym::Expr s : ctx.freeSymbols(sum.body)) {
+  for (sym::Expr s : ctx.freeSymbols(body)) {
     const flat::RelativeElement* rel = m.relativeElement(s);
     if (!rel) continue;
     const flat::ArrayVariable& a = m.patterns->arrays[rel->array];
@@ -86,8 +87,13 @@ bool loopsReadSum(const flat::FlatModel& m, const flat::IndexedSum& sum, const s
     }
   }
   return std::all_of(parameters.begin(), parameters.end(), [&](const flat::RelativeElement* rel) {
-    return shape && flat::loopableParameters(m, *rel, sum.box.size(), *shape);
+    return shape && flat::loopableParameters(m, *rel, rank, *shape);
   });
+}
+
+bool loopsReadForce(const flat::FlatModel& m, const flat::IndexedForce& f, const sym::Context& ctx) {
+  const flat::ArrayVariable& target = m.patterns->arrays[m.relativeElement(f.target)->array];
+  return loopsRead(m, f.body, f.box.size(), &target.shape, ctx);
 }
 
 // Where the stages after flattening take templates (docs/loops.md): a model of energies over
@@ -95,14 +101,17 @@ bool loopsReadSum(const flat::FlatModel& m, const flat::IndexedSum& sum, const s
 // work on scalars), initial equations that are start values at most. Its Jacobi integral is a
 // sum over every element: the kernels loop it too.
 bool templatesApply(const flat::FlatModel& m, const CompileOptions& o, const sym::Context& ctx) {
-  if (!o.keepLoops || m.indexedSums.empty()) return false;
+  if (!o.keepLoops || (m.indexedSums.empty() && m.indexedForces.empty())) return false;
   if (!m.equations.empty() || !m.constraints.empty() || m.components.size() > 1) return false;
   if (!dae::initialEquationsAreStartValues(m, ctx)) return false;
   bool plain = std::none_of(m.variables.begin(), m.variables.end(), [](const flat::Variable& v) {
     return v.alias || v.role == flat::VarRole::Unknown || v.role == flat::VarRole::Derivative;
   });
-  return plain && std::all_of(m.indexedSums.begin(), m.indexedSums.end(),
-                              [&](const flat::IndexedSum& sum) { return loopsReadSum(m, sum, ctx); });
+  return plain &&
+         std::all_of(m.indexedSums.begin(), m.indexedSums.end(),
+                     [&](const flat::IndexedSum& sum) { return loopsRead(m, sum.body, sum.box.size(), nullptr, ctx); }) &&
+         std::all_of(m.indexedForces.begin(), m.indexedForces.end(),
+                     [&](const flat::IndexedForce& f) { return loopsReadForce(m, f, ctx); });
 }
 
 // Gives the pages of freed blocks back to the system, so that what the solver allocates next

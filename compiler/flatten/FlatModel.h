@@ -198,6 +198,21 @@ struct IndexedSum {
   SourceRange range;  ///< the sum(...) call
 };
 
+/// `for i in a:b, j in c:d loop force(x[i+o, j+p]) = body; end for` in the mechanics section, kept
+/// as one template instead of one force per element (FlattenLimits::keepLoops, issue 15): at every
+/// point of the box the generalized force `body` on the element `target` (a relative symbol of an
+/// array of coordinates, subscript d iterator d plus a constant). Expanded, its forces go to
+/// FlatModel::forces at `position`, where the scalar lowering puts them: point by point, the
+/// forces of one loop (its `first` template and those after it with the same `first`) in turn.
+struct IndexedForce {
+  Box box;  ///< per iterator: first and last value
+  sym::Expr target = nullptr;
+  sym::Expr body = nullptr;
+  SourceRange range;  ///< the force statement
+  size_t position = 0;
+  size_t first = 0;  ///< index in FlatModel::indexedForces of its loop's first force
+};
+
 /// Σ over a box of iterator values of `body`, an expression over relative symbols (%k: iterator k)
 /// whose arrays have `shape` and are subscripted in dimension d by iterator d plus a constant (in one
 /// dimension, any length): a sum over every element that a loop computes (issue 15) — a templated
@@ -240,6 +255,7 @@ struct FlatModel {
   /// Repeated structure kept as templates (only when flattened with FlattenLimits::keepLoops; see
   /// expandIndexedSums): the sums, the arrays their relative symbols index, and those symbols.
   std::vector<IndexedSum> indexedSums;
+  std::vector<IndexedForce> indexedForces;  ///< `force(x[i]) = …` in `for` loops, kept as templates
   std::shared_ptr<ElementPatterns> patterns = std::make_shared<ElementPatterns>();
   /// `for` equations kept as templates (FlattenLimits::keepForEquations); their points are not in
   /// `equations`.

@@ -562,6 +562,7 @@ void Flattener::lowerEquation(const ast::Equation& eq, std::vector<flat::Equatio
 void Flattener::lowerMechanics(const MechanicsStmt& st) {
   switch (st.kind) {
     case MechanicsKind::For:
+      if (limits_.keepLoops && iterators_.empty() && lowerForceTemplates(st)) return;
       forEachIteration(st.iterators, 0, [&] {
         for (const auto& b : st.body) guarded([&] { lowerMechanics(b); });
       });

@@ -349,6 +349,62 @@ std::optional<EquationTemplate> Flattener::lowerEquationTemplate(const ast::Equa
   return t;
 }
 
+// --- forces in `for` loops (FlattenLimits::keepLoops) ---
+
+// Every statement of a top-level mechanics loop (and of the loops nested in it while each holds only
+// the next) a force on `x[i + o, …]`, x an array of coordinates subscripted by the iterators in
+// order, as a template; or false (nothing recorded) where the scalar lowering must do the loop.
+bool Flattener::lowerForceTemplates(const MechanicsStmt& loop) {
+  std::vector<TemplateIterator> its;
+  const MechanicsStmt* inner = &loop;
+  for (;;) {
+    for (const auto& it : inner->iterators)
+      if (!addTemplateIterator(it, its)) return false;
+    if (inner->body.size() != 1 || inner->body[0].kind != MechanicsKind::For) break;
+    inner = &inner->body[0];
+  }
+  if (inner->body.empty()) return false;
+  std::vector<IndexedForce> forces;
+  for (const MechanicsStmt& st : inner->body) {
+    std::optional<IndexedForce> f = st.kind == MechanicsKind::Force ? lowerForceTemplate(st, its) : std::nullopt;
+    if (!f) return false;
+    forces.push_back(std::move(*f));
+  }
+  countScalars(pointCount(forces[0].box) * forces.size(), loop.range);
+  size_t first = out_.indexedForces.size();
+  for (IndexedForce& f : forces) f.position = out_.forces.size(), f.first = first, out_.indexedForces.push_back(std::move(f));
+  return true;
+}
+
+std::optional<IndexedForce> Flattener::lowerForceTemplate(const MechanicsStmt& st, const std::vector<TemplateIterator>& its) {
+  TemplateCheck check(its);
+  if (!st.target || !st.value || st.at || !isa<IndexExpr>(st.target.get()) || !check.body(*st.target) ||
+      !check.body(*st.value))
+    return std::nullopt;
+  IndexedForce f;
+  templateIterators_ = its;
+  try {
+    f.target = lowerScalar(*st.target, "the coordinate of a force");
+    f.body = lowerScalar(*st.value, "a force");
+  } catch (NotATemplate&) {
+    templateIterators_.clear();
+    return std::nullopt;
+  } catch (...) {
+    templateIterators_.clear();
+    throw;
+  }
+  templateIterators_.clear();
+  const RelativeElement* rel = out_.patterns->find(f.target);
+  if (!rel || rel->dims.size() != its.size()) return std::nullopt;
+  for (size_t d = 0; d < rel->dims.size(); ++d)
+    if (rel->dims[d].iterator != static_cast<int>(d)) return std::nullopt;
+  int var = out_.variableOf(out_.patterns->arrays[rel->array].elements[0]);
+  if (var < 0 || out_.variables[var].role != VarRole::Coordinate) return std::nullopt;  // the scalar lowering reports it
+  for (const auto& it : its) f.box.push_back({it.first, it.last});
+  f.range = st.range;
+  return f;
+}
+
 // x[i+1] inside a template: the relative symbol of that pattern (nullopt: no iterator in the
 // subscripts, an ordinary subscript).
 std::optional<Value> Flattener::lowerRelativeIndex(const IndexExpr& e) {
@@ -493,6 +549,22 @@ void expandIndexedSums(FlatModel& model, sym::Context& ctx) {
     terms[sum.term].value = ctx.add(terms[sum.term].value, ctx.add(parts));
   }
   model.indexedSums.clear();
+  // Later loops first: each inserts its forces where the scalar lowering would have put them, point
+  // by point its statements in turn.
+  const std::vector<IndexedForce>& all = model.indexedForces;
+  for (size_t end = all.size(); end > 0;) {
+    size_t begin = all[end - 1].first;
+    std::vector<std::pair<int, Term>> forces;
+    forEachPoint(all[begin].box, [&](std::span<const long> point, size_t) {
+      for (size_t k = begin; k < end; ++k) {
+        Expr target = instantiate(model, ctx, all[k].target, point);
+        forces.push_back({model.variableOf(target), {instantiate(model, ctx, all[k].body, point), all[k].range}});
+      }
+    });
+    model.forces.insert(model.forces.begin() + static_cast<long>(all[begin].position), forces.begin(), forces.end());
+    end = begin;
+  }
+  model.indexedForces.clear();
 }
 
 }  // namespace qdot::flat

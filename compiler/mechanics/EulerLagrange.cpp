@@ -56,14 +56,15 @@ class Deriver {
   std::optional<EquationsOfMotion> run() {
     size_t errorsBefore = diags_.errorCount();
     std::vector<flat::Term> kinetic = m_.kinetic, potential = m_.potential, dissipation = m_.dissipation;
-    if (!m_.indexedSums.empty()) expandScalarSums(kinetic, potential, dissipation);
+    bool templates = !m_.indexedSums.empty() || !m_.indexedForces.empty();
+    if (templates) expandScalarTemplates(kinetic, potential, dissipation);
     index(lagrangian_, kinetic, 1.0);
     index(lagrangian_, potential, -1.0);
     index(dissipation_, dissipation, 1.0);
     lagrangian_.finish(m_.variables.size());
     dissipation_.finish(m_.variables.size());
     makeMultipliers();
-    if (!m_.indexedSums.empty()) deriveTemplates();
+    if (templates) deriveTemplates();
     for (int q : m_.variablesWithRole(VarRole::Coordinate)) derive(q);
     if (diags_.errorCount() > errorsBefore) return std::nullopt;
     findFirstIntegrals();
@@ -180,6 +181,7 @@ class Deriver {
       out_.multipliers.push_back({name, ctx_.symbol(name), static_cast<int>(k)});
     }
     for (const auto& [q, term] : m_.forces) forces_[q].push_back(term.value);
+    for (const auto& [q, value] : scalarForces_) forces_[q].push_back(value);
   }
 
   std::span<const Expr> forcesOn(int q) const {
@@ -220,15 +222,24 @@ class Deriver {
   std::vector<int> templateOf_;  ///< by flat variable: the template row of its element, or -1
   /// The templates' contributions to a peeled element's row, instantiated (by flat variable).
   struct PeeledExtras {
-    Expr momentum = nullptr, position = nullptr, dissipation = nullptr;
+    Expr momentum = nullptr, position = nullptr, dissipation = nullptr, force = nullptr;
   };
   std::unordered_map<int, PeeledExtras> extras_;
   bool templated_ = false;
 
-  // Sums that cannot give template rows become the scalar terms flattening would have made.
-  void expandScalarSums(std::vector<flat::Term>& kinetic, std::vector<flat::Term>& potential,
-                        std::vector<flat::Term>& dissipation) {
-    for (int s : sumsWithoutTemplates(m_, ctx_)) {
+  // Sums and forces that cannot give template rows become the scalar terms and forces flattening
+  // would have made.
+  void expandScalarTemplates(std::vector<flat::Term>& kinetic, std::vector<flat::Term>& potential,
+                             std::vector<flat::Term>& dissipation) {
+    TemplateDerivation t = templatesWithoutRows(m_, ctx_);
+    for (int f : t.scalarForces) {
+      const flat::IndexedForce& force = m_.indexedForces[f];
+      flat::forEachPoint(force.box, [&](std::span<const long> point, size_t) {
+        int q = m_.variableOf(flat::instantiate(m_, ctx_, force.target, point));
+        scalarForces_.push_back({q, flat::instantiate(m_, ctx_, force.body, point)});
+      });
+    }
+    for (int s : t.scalarSums) {
       const flat::IndexedSum& sum = m_.indexedSums[s];
       auto& terms = sum.energy == flat::IndexedSum::Energy::Kinetic     ? kinetic
                     : sum.energy == flat::IndexedSum::Energy::Potential ? potential
@@ -240,6 +251,7 @@ class Deriver {
     }
   }
   std::vector<int> scalarSums_;
+  std::vector<std::pair<int, Expr>> scalarForces_;  ///< force templates made scalar: (coordinate, force)
 
   // Coordinates that occur in scalar terms, forces or constraints keep scalar rows (peeled).
   std::vector<char> peeledCoordinates() const {
@@ -264,18 +276,21 @@ class Deriver {
       });
     }
     // Peeled elements and regions of one element: their contributions, instantiated.
-    std::map<int, std::array<std::vector<Expr>, 3>> parts;  // by flat variable: momentum, position, dissipation
+    std::map<int, std::array<std::vector<Expr>, 4>> parts;  // by flat variable: momentum, position, dissipation, force
     for (const Contribution& c : t.contributions) {
       const auto& a = arrays[c.array];
       flat::forEachPoint(c.box, [&](std::span<const long> point, size_t) {
         int q = m_.variableOf(a.elements[flat::linearIndex(a.shape, point)]);
         if (templateOf_[q] >= 0) return;
-        int part = c.part == Contribution::Part::Momentum ? 0 : c.part == Contribution::Part::Position ? 1 : 2;
+        int part = c.part == Contribution::Part::Momentum   ? 0
+                   : c.part == Contribution::Part::Position ? 1
+                   : c.part == Contribution::Part::Force    ? 3
+                                                            : 2;
         parts[q][part].push_back(flat::instantiate(m_, ctx_, c.value, point));
       });
     }
     auto sum = [&](const std::vector<Expr>& terms) { return terms.empty() ? nullptr : ctx_.add(terms); };
-    for (const auto& [q, p] : parts) extras_[q] = {sum(p[0]), sum(p[1]), sum(p[2])};
+    for (const auto& [q, p] : parts) extras_[q] = {sum(p[0]), sum(p[1]), sum(p[2]), sum(p[3])};
     out_.templateRows = std::move(t.rows);
   }
 
@@ -290,11 +305,12 @@ class Deriver {
     }
     auto found = extras_.find(q);
     PeeledExtras none, &extras = found == extras_.end() ? none : found->second;
-    bool extra = extras.momentum || extras.position || extras.dissipation;
+    bool extra = extras.momentum || extras.position || extras.dissipation || extras.force;
     Expr p = plus(partial(lagrangian_, v), extras.momentum);
     std::vector<Expr> parts{timeDerivative(p), ctx_.neg(plus(partial(lagrangian_, q), extras.position)),
                             plus(partial(dissipation_, v), extras.dissipation)};
     for (Expr f : forcesOn(q)) parts.push_back(ctx_.neg(f));
+    if (extras.force) parts.push_back(ctx_.neg(extras.force));
     bool constrained = false;
     for (const auto& mult : out_.multipliers) {
       Expr dg = ctx_.diff(m_.constraints[mult.constraint].residual, coord.symbol);
@@ -315,7 +331,8 @@ class Deriver {
   void findFirstIntegrals() {
     // Connector flows are forces between components: with connectionsConserveEnergy their power
     // cancels node by node, so only `force(q)` statements make the system non-conservative.
-    bool statedForces = std::any_of(m_.forces.begin(), m_.forces.end(), [](const auto& f) { return !f.second.connectionFlow; });
+    bool statedForces = !m_.indexedForces.empty() ||
+                        std::any_of(m_.forces.begin(), m_.forces.end(), [](const auto& f) { return !f.second.connectionFlow; });
     bool conservative = m_.dissipation.empty() && !statedForces && m_.connectionsConserveEnergy &&
                         !lagrangian_.dependsOnTime;
     for (const auto& c : m_.constraints) conservative &= !ctx_.dependsOn(c.residual, m_.time());
@@ -331,7 +348,7 @@ class Deriver {
       // A peeled element of a templated array is in the templates' sums too (the last mass of a
       // chain: in no scalar term, but in the springs' sum).
       auto found = extras_.find(row.coordinate);
-      bool inTemplates = found != extras_.end() && (found->second.position || found->second.dissipation);
+      bool inTemplates = found != extras_.end() && (found->second.position || found->second.dissipation || found->second.force);
       bool cyclic = !m_.variables[row.coordinate].alias && lagrangian_.termsOf(row.coordinate).empty() &&
                     forcesOn(row.coordinate).empty() && !inTemplates &&
                     dissipation_.termsOf(v).empty() && !row.momentum->isZero();

@@ -25,6 +25,8 @@ class TemplateDeriver {
   TemplateDerivation run(bool rows = true) {
     for (int s = 0; s < static_cast<int>(m_.indexedSums.size()); ++s)
       if (!contribute(m_.indexedSums[s])) out_.scalarSums.push_back(s);
+    for (int f = 0; f < static_cast<int>(m_.indexedForces.size()); ++f)
+      if (!contributeForce(m_.indexedForces[f])) out_.scalarForces.push_back(f);
     if (!rows) return std::move(out_);
     std::vector<int> arrays;
     for (const Contribution& c : contributions_) arrays.push_back(c.array);
@@ -93,6 +95,36 @@ class TemplateDeriver {
       found.push_back(std::move(c));
     }
     contributions_.insert(contributions_.end(), found.begin(), found.end());
+    return true;
+  }
+
+  // Records a force template's contribution; false if its body reads a scalar coordinate or
+  // velocity (the rows would need ∂/∂ of it across the loop) or an array of coordinates, velocities
+  // or accelerations across its iterators.
+  bool contributeForce(const flat::IndexedForce& f) {
+    for (Expr s : ctx_.freeSymbols(f.body)) {
+      const RelativeElement* rel = patterns_.find(s);
+      if (!rel) {
+        VarRole r = roleOf(s);
+        if (r != VarRole::Parameter && r != VarRole::Time) return false;
+        continue;
+      }
+      if (roleOf(patterns_.arrays[rel->array].elements[0]) == VarRole::Parameter) continue;
+      if (rel->dims.size() != f.box.size()) return false;
+      for (size_t d = 0; d < rel->dims.size(); ++d)
+        if (rel->dims[d].iterator != static_cast<int>(d)) return false;
+    }
+    const RelativeElement& target = *patterns_.find(f.target);
+    Contribution c;
+    c.array = target.array;
+    c.part = Contribution::Part::Force;
+    std::vector<long> offset;
+    for (size_t d = 0; d < target.dims.size(); ++d) {
+      offset.push_back(target.dims[d].offset);
+      c.box.push_back({f.box[d].first + offset[d], f.box[d].second + offset[d]});
+    }
+    c.value = shift(f.body, offset);
+    contributions_.push_back(std::move(c));
     return true;
   }
 
@@ -177,17 +209,19 @@ class TemplateDeriver {
   void rowOn(int a, const Box& region) {
     TemplateRow row{a, region, nullptr, nullptr};
     if (flat::pointCount(row.region) < 2) return;  // one element: a scalar row
-    std::vector<Expr> momentum, position, dissipation;
+    std::vector<Expr> momentum, position, dissipation, force;
     for (const Contribution& c : contributions_) {
       if (c.array != a || !contains(c.box, region)) continue;
       auto& into = c.part == Contribution::Part::Momentum   ? momentum
                    : c.part == Contribution::Part::Position ? position
+                   : c.part == Contribution::Part::Force    ? force
                                                             : dissipation;
       into.push_back(c.value);
     }
-    if (momentum.empty() && position.empty() && dissipation.empty()) return;
+    if (momentum.empty() && position.empty() && dissipation.empty()) return;  // forces alone: no inertia
     row.momentum = simplify_(ctx_.add(momentum));
-    std::vector<Expr> parts{timeDerivative(row.momentum), ctx_.neg(ctx_.add(position)), ctx_.add(dissipation)};
+    std::vector<Expr> parts{timeDerivative(row.momentum), ctx_.neg(ctx_.add(position)), ctx_.add(dissipation),
+                            ctx_.neg(ctx_.add(force))};
     Expr residual = ctx_.add(parts);
     row.residual = simplify_(residual);
     if (!ctx_.dependsOn(row.residual, ownAcceleration(a))) return;  // no inertia of its own: scalar rows
@@ -210,9 +244,9 @@ class TemplateDeriver {
 
 }  // namespace
 
-std::vector<int> sumsWithoutTemplates(const flat::FlatModel& model, sym::Context& ctx) {
+TemplateDerivation templatesWithoutRows(const flat::FlatModel& model, sym::Context& ctx) {
   std::vector<char> none(model.variables.size(), 0);
-  return TemplateDeriver(model, ctx, none, sym::SimplifyLevel::None).run(false).scalarSums;
+  return TemplateDeriver(model, ctx, none, sym::SimplifyLevel::None).run(false);
 }
 
 TemplateDerivation deriveTemplateRows(const flat::FlatModel& model, sym::Context& ctx, const std::vector<char>& peeled,

@@ -2,6 +2,7 @@
 // instead of once per element (issue 15, docs/loops.md). Each IndexedSum of the flat model that
 // contains `x[%1+o]` or `der(x)[%1+o]` contributes, on its box shifted by +o, the derivative of its
 // body by that symbol with every offset shifted by −o (so that %k is the row's own subscript).
+// An IndexedForce on `x[%1+o]` contributes its body, shifted by −o, as a generalized force.
 // Splitting each dimension at the ends of those boxes gives regions on which the row is one
 // template. Regions of a single element, and elements that also occur in scalar terms, forces or
 // constraints (peeled), are left to the scalar derivation.
@@ -30,7 +31,8 @@ struct TemplateRow {
 struct Contribution {
   int array = -1;  ///< the coordinates
   flat::Box box;
-  enum class Part : uint8_t { Momentum, Position, Dissipation } part = Part::Position;  ///< ∂L/∂v, ∂L/∂q, ∂D/∂v
+  /// ∂L/∂v, ∂L/∂q, ∂D/∂v, or a generalized force Q (IndexedForce; the row has −Q)
+  enum class Part : uint8_t { Momentum, Position, Dissipation, Force } part = Part::Position;
   sym::Expr value = nullptr;
 };
 
@@ -43,10 +45,14 @@ struct TemplateDerivation {
   /// coupling an element to a scalar coordinate, or indexing coordinates other than x[%1+o, %2+p]):
   /// the caller expands them into the scalar terms.
   std::vector<int> scalarSums;
+  /// IndexedForces (indices into FlatModel::indexedForces) whose body reads a scalar coordinate or
+  /// velocity, or an array across its iterators: the caller makes them scalar forces.
+  std::vector<int> scalarForces;
 };
 
-/// The IndexedSums that cannot give template rows (TemplateDerivation::scalarSums).
-std::vector<int> sumsWithoutTemplates(const flat::FlatModel& model, sym::Context& ctx);
+/// The IndexedSums and IndexedForces that cannot give template rows (TemplateDerivation::scalarSums,
+/// scalarForces; no rows derived).
+TemplateDerivation templatesWithoutRows(const flat::FlatModel& model, sym::Context& ctx);
 
 /// Derives the template rows of model.indexedSums. `peeled` (by flat variable) marks coordinates
 /// that also occur in scalar terms, forces or constraints: their rows stay scalar.

@@ -41,6 +41,11 @@ void expectExpandsToScalar(test::SourceDae& s, Flattened& f) {
   expectSameTerms(f.scalar->kinetic, f.templated->kinetic, "kinetic");
   expectSameTerms(f.scalar->potential, f.templated->potential, "potential");
   expectSameTerms(f.scalar->dissipation, f.templated->dissipation, "dissipation");
+  ASSERT_EQ(f.scalar->forces.size(), f.templated->forces.size());
+  for (size_t i = 0; i < f.scalar->forces.size(); ++i) {
+    EXPECT_EQ(f.scalar->forces[i].first, f.templated->forces[i].first) << "force " << i;
+    EXPECT_EQ(f.scalar->forces[i].second.value, f.templated->forces[i].second.value) << "force " << i;
+  }
   ASSERT_EQ(f.scalar->variables.size(), f.templated->variables.size());
   for (size_t i = 0; i < f.scalar->variables.size(); ++i)
     EXPECT_EQ(f.scalar->variables[i].symbol, f.templated->variables[i].symbol) << "variable " << i;
@@ -72,6 +77,48 @@ TEST(IndexedSum, ChainKeepsEverySumAndExpandsToTheScalarTerms) {
   ASSERT_NE(rel, nullptr);
   EXPECT_EQ(rel->dims[0].iterator, 0);
   EXPECT_EQ(rel->dims[0].offset, 1);
+  expectExpandsToScalar(s, f);
+}
+
+// Forces in `for` loops (IndexedForce): one template per force statement of a loop whose body is
+// only forces on x[i + o] (nested loops too); expanded, the forces the scalar lowering gives, node
+// for node and in the same places among the other forces. A force on a constant element, or with
+// the iterator used as a number, keeps its loop scalar.
+TEST(IndexedForce, ForceLoopsAreTemplatesAndExpandToTheScalarForces) {
+  test::SourceDae s("forces.qd", R"(model Forces
+  parameter Integer n = 6, m = 3;
+  parameter Real k = 1000, c = 0.5, a[n] = {0.1*i for i in 1:n};
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+  coordinate Real z[n, m](each start = 0.1);
+mechanics
+  kinetic = sum(0.5*der(x[i])^2 for i in 1:n) + sum(0.5*der(z[i, j])^2 for i in 1:n, j in 1:m);
+  potential = 0.5*k*x[1]^2 + sum(0.5*k*(x[i+1] - x[i])^2 for i in 1:n-1) + sum(k*z[i, j]^2 for i in 1:n, j in 1:m);
+  force(x[2]) = -1;
+  for i in 2:n loop
+    force(x[i]) = -c*der(x[i]) + a[i]*sin(time);
+    force(x[i-1]) = c*(der(x[i]) - der(x[i-1]));
+  end for;
+  force(x[n]) = 2;
+  for i in 1:n loop
+    for j in 1:m loop
+      force(z[i, j]) = -c*der(z[i, j]) + x[i];
+    end for;
+  end for;
+  for i in 1:n loop
+    force(x[1]) = 0.01*i;
+  end for;
+  for i in 1:n loop
+    force(x[i]) = 0.01*i;
+  end for;
+end Forces;
+)", driver::Stage::Check);
+  Flattened f = flattenBoth(s);
+  ASSERT_TRUE(f.templated);
+  ASSERT_EQ(f.templated->indexedForces.size(), 3u);  // the loop of two and the nested loop
+  EXPECT_EQ(f.templated->indexedForces[0].box, (flat::Box{{2, 6}}));
+  EXPECT_EQ(f.templated->indexedForces[0].position, 1u);  // after force(x[2])
+  EXPECT_EQ(f.templated->indexedForces[2].box, (flat::Box{{1, 6}, {1, 3}}));
+  EXPECT_EQ(f.templated->forces.size(), 2u + 6u + 6u);  // the scalar ones, and the two loops kept scalar
   expectExpandsToScalar(s, f);
 }
 

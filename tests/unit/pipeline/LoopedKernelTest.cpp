@@ -111,6 +111,55 @@ end Chain;
   EXPECT_FALSE(implicit.c.dae->templated());
 }
 
+// Forces in `for` loops are templates of the rows: a parameter array, time and neighbours' velocities
+// in the loop; a loop whose force reads the scalar z gives scalar rows to the elements it pushes.
+TEST(LoopedKernels, ForcesInLoopsGiveTheScalarResidualAndJacobian) {
+  size_t loops = expectSameKernels(R"(model Forced
+  parameter Integer n = 12;
+  parameter Real k = 1000, c = 0.1, F0 = 2, w = 5;
+  parameter Real m[n] = {1 + 0.1*i for i in 1:n};
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+  coordinate Real z(start = 0.1);
+mechanics
+  kinetic = sum(0.5*m[i]*der(x[i])^2 for i in 1:n) + 0.5*der(z)^2;
+  potential = 0.5*k*x[1]^2 + sum(0.5*k*(x[i+1] - x[i])^2 for i in 1:n-1) + 0.5*k*(z - x[3])^2;
+  for i in 2:n loop
+    force(x[i]) = -c*der(x[i]) + F0*m[i]*sin(w*time + x[i]) - c*(der(x[i]) - der(x[i-1]));
+  end for;
+  for i in 1:n-1 loop
+    force(x[i]) = 0.5*c*(der(x[i+1]) - der(x[i]));
+  end for;
+  for i in 1:2 loop
+    force(x[i]) = -z*x[i];
+  end for;
+end Forced;
+)");
+  EXPECT_EQ(loops, 2u);  // x[4..11]: one loop; the kinematic rows
+}
+
+// The same physics written two ways: viscous damping to the ground as a force per mass in a loop,
+// and as the dissipation function ½c Σ ẋᵢ². Both looped, their rows agree at random states.
+TEST(LoopedKernels, DampingAsForcesInALoopEqualsDampingAsADissipationSum) {
+  auto chain = [](const std::string& damping, const std::string& forces) {
+    return R"(model Chain
+  parameter Integer n = 10;
+  parameter Real k = 1000, c = 0.3;
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+mechanics
+  kinetic = sum(0.5*der(x[i])^2 for i in 1:n);
+  potential = 0.5*k*x[1]^2 + sum(0.5*k*(x[i+1] - x[i])^2 for i in 1:n-1);
+)" + damping + forces + "end Chain;\n";
+  };
+  Compiled asForces(chain("", "  for i in 1:n loop\n    force(x[i]) = -c*der(x[i]);\n  end for;\n"), true);
+  Compiled asSum(chain("  dissipation = sum(0.5*c*der(x[i])^2 for i in 1:n);\n", ""), true);
+  EXPECT_GT(loopCount(asForces.kernels().program(ModelProgram::Residual)), 0u);
+  for (int trial = 0; trial < 3; ++trial) {
+    test::KernelValues a = test::evaluateAt(asForces.kernels(), trial), b = test::evaluateAt(asSum.kernels(), trial);
+    ASSERT_EQ(a.F.size(), b.F.size());
+    for (size_t i = 0; i < a.F.size(); ++i) EXPECT_NEAR(a.F[i], b.F[i], 1e-13 * (1 + std::abs(b.F[i]))) << "F[" << i << "]";
+  }
+}
+
 TEST(LoopedKernels, SpringChainGivesTheScalarResidualAndJacobian) {
   size_t loops = expectSameKernels(R"(model Chain
   parameter Integer n = 9;
