@@ -69,9 +69,11 @@ bool check(Compilation& c) {
 // Whether every relative symbol of a template's body is one the loops read: an array of
 // coordinates or velocities, or an array of parameters a loop addresses as p[first + linear index]
 // (flat::loopableParameters; in several dimensions of the shape of the coordinates the template
-// reads). `shape`: the coordinates' shape if known (a force's target), else null.
+// reads); an iterator used as a number only in one dimension (a loop computes it from its offset).
+// `shape`: the coordinates' shape if known (a force's target), else null.
 bool loopsRead(const flat::FlatModel& m, sym::Expr body, size_t rank, const std::vector<int>* shape,
                const sym::Context& ctx) {
+  if (rank > 1 && m.patterns->readsIterator(ctx, body)) return false;  // an iterator's value: 1-D loops only
   std::vector<const flat::RelativeElement*> parameters;
   for (sym::Expr s : ctx.freeSymbols(body)) {
     const flat::RelativeElement* rel = m.relativeElement(s);
@@ -112,6 +114,16 @@ bool templatesApply(const flat::FlatModel& m, const CompileOptions& o, const sym
                      [&](const flat::IndexedSum& sum) { return loopsRead(m, sum.body, sum.box.size(), nullptr, ctx); }) &&
          std::all_of(m.indexedForces.begin(), m.indexedForces.end(),
                      [&](const flat::IndexedForce& f) { return loopsReadForce(m, f, ctx); });
+}
+
+// Whether a template of the model reads an iterator as a number (`0.1*i`): expanded, it is equal
+// to the scalar lowering to rounding, not node for node (its constants fold in another order).
+bool readsIterators(const flat::FlatModel& m, const sym::Context& ctx) {
+  for (const auto& sum : m.indexedSums)
+    if (m.patterns->readsIterator(ctx, sum.body)) return true;
+  for (const auto& f : m.indexedForces)
+    if (m.patterns->readsIterator(ctx, f.body)) return true;
+  return false;
 }
 
 // Gives the pages of freed blocks back to the system, so that what the solver allocates next
@@ -160,7 +172,17 @@ bool flatten(Compilation& c) {
     if (forEquationsMayStay(c))
       if (auto model = flattenKeepingEquations(c, limits)) return model;
     auto model = flat::flatten(*c.checked, c.ctx, c.diags, limits, c.options.structural);
-    if (model && !templatesApply(*model, c.options, c.ctx)) flat::expandIndexedSums(*model, c.ctx);
+    if (model && !templatesApply(*model, c.options, c.ctx)) {
+      if (!readsIterators(*model, c.ctx) || c.diags.hasErrors()) {
+        flat::expandIndexedSums(*model, c.ctx);  // exactly the scalar lowering's nodes
+      } else {  // an iterator's value folds in another order than the scalar lowering's: flatten again
+        model.reset();
+        c.ctx.clear();
+        limits.keepLoops = false;
+        DiagnosticEngine again;  // the same diagnostics as the first time, already reported
+        model = flat::flatten(*c.checked, c.ctx, again, limits, c.options.structural);
+      }
+    }
     return model;
   });
   return c.flat && !c.diags.hasErrors();

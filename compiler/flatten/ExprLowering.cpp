@@ -79,6 +79,8 @@ Value Flattener::lower(const ast::Expr& e) {
 Value Flattener::lowerName(const NameExpr& n) {
   if (n.parts.size() > 1) return frames_.empty() ? lowerDotted(n) : lowerFunctionName(n);
   const std::string& name = n.parts[0];
+  for (size_t k = 0; k < templateIterators_.size(); ++k)  // a template's iterator as a number
+    if (templateIterators_[k].name == name) return Value::scalar(out_.patterns->iteratorSymbol(ctx_, static_cast<int>(k)));
   for (auto it = iterators_.rbegin(); it != iterators_.rend(); ++it)
     if (it->first == name) return Value::scalar(it->second);
   if (!frames_.empty()) return lowerFunctionName(n);

@@ -181,8 +181,21 @@ class ElementPatterns {
   /// The element a relative symbol stands for at a point of its template's iterators.
   sym::Expr elementAt(const RelativeElement& rel, std::span<const long> point) const;
 
+  /// The value of a template's iterator k (0-based) used as a number (`0.1*i`), the symbol `%k+1`;
+  /// made on first use. In one dimension only: a 1-D loop computes it from its offset (ldidx).
+  sym::Expr iteratorSymbol(sym::Context& ctx, int k);
+  /// The iterator whose value a symbol is, or -1.
+  int iteratorOf(sym::Expr s) const {
+    for (size_t k = 0; k < iterators_.size(); ++k)
+      if (iterators_[k] == s) return static_cast<int>(k);
+    return -1;
+  }
+  /// Whether e reads an iterator's value.
+  bool readsIterator(const sym::Context& ctx, sym::Expr e) const;
+
  private:
   std::unordered_map<uint32_t, RelativeElement> elements_;  ///< by symbolId
+  std::vector<sym::Expr> iterators_;                        ///< by iterator
 };
 
 /// `sum(body for i in a:b, j in c:d)` in an energy, kept as one template instead of one term per

@@ -27,8 +27,9 @@ bool mentions(const ast::Expr* e, const std::vector<TemplateIterator>& its);
 }  // namespace
 
 /// Decides from the syntax alone whether a sum's body can be lowered as a template: arithmetic,
-/// der() and elementary functions over numbers, names and subscripts, with the iterators only in
-/// subscripts of declared arrays as `i`, `i + e`, `e + i` or `i - e` (e free of iterators).
+/// der() and elementary functions over numbers, names and subscripts, with the iterators in
+/// subscripts of declared arrays only as `i`, `i + e`, `e + i` or `i - e` (e free of iterators),
+/// and elsewhere as numbers (`0.1*i`).
 /// Checking first means the template lowering never meets an iterator where a number is needed.
 class TemplateCheck {
  public:
@@ -37,7 +38,7 @@ class TemplateCheck {
   bool body(const ast::Expr& e) const {
     switch (e.kind) {
       case ExprKind::Number: return true;
-      case ExprKind::Name: return !isIterator(*cast<NameExpr>(&e));
+      case ExprKind::Name: return true;  // an iterator as a number too (`0.1*i`: its value, %k)
       case ExprKind::Unary: return cast<UnaryExpr>(&e)->op != UnaryOp::Not && body(*cast<UnaryExpr>(&e)->operand);
       case ExprKind::Binary: {
         auto* b = cast<BinaryExpr>(&e);
@@ -507,6 +508,19 @@ Expr ElementPatterns::symbol(sym::Context& ctx, const RelativeElement& rel) {
   return s;
 }
 
+Expr ElementPatterns::iteratorSymbol(sym::Context& ctx, int k) {
+  if (iterators_.size() <= static_cast<size_t>(k)) iterators_.resize(k + 1, nullptr);
+  if (!iterators_[k]) iterators_[k] = ctx.symbol("%" + std::to_string(k + 1));
+  return iterators_[k];
+}
+
+bool ElementPatterns::readsIterator(const sym::Context& ctx, Expr e) const {
+  if (iterators_.empty()) return false;
+  for (Expr s : ctx.freeSymbols(e))
+    if (iteratorOf(s) >= 0) return true;
+  return false;
+}
+
 Expr ElementPatterns::elementAt(const RelativeElement& rel, std::span<const long> point) const {
   const ArrayVariable& a = arrays[rel.array];
   size_t flat = 0;
@@ -521,6 +535,7 @@ Expr instantiate(const FlatModel& model, sym::Context& ctx, Expr body, std::span
   std::unordered_map<Expr, Expr> map;
   for (Expr s : ctx.freeSymbols(body))
     if (const RelativeElement* rel = model.relativeElement(s)) map.emplace(s, model.patterns->elementAt(*rel, point));
+    else if (int k = model.patterns->iteratorOf(s); k >= 0) map.emplace(s, ctx.constant(static_cast<double>(point[k])));
   return ctx.substitute(body, map);
 }
 

@@ -12,6 +12,7 @@
 #include "dae/Initialization.h"
 #include "kernel/Jacobian.h"
 #include "kernel/Lowering.h"
+#include "support/Assert.h"
 #include "support/Diagnostic.h"
 #include "symbolic/Simplify.h"
 
@@ -505,6 +506,7 @@ class Builder {
     for (TemplateEntry& e : jac.templateEntries)
       if (jacobian && e.block == static_cast<int>(k)) roots.push_back(e.value), entries.push_back(&e);
     if (roots.empty()) return;
+    Expr offset = iteratorsFromOffset(b, roots, block.region);
     sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, roots, "$b" + std::to_string(k) + (jacobian ? "j" : "r"));
     b.setSource(blockSource(k));
     std::vector<long> lo;
@@ -515,7 +517,7 @@ class Builder {
       b.bindLoopedLoad(op.symbol, op.parameter ? Op::LoadPLooped : op.derivative ? Op::LoadYpLooped : Op::LoadYLooped,
                        static_cast<uint32_t>(op.variable + base + op.offset));
     for (const auto& [t, value] : cse.temporaries) b.bindTemporary(t, value);
-    for (Expr t : invariantTemporaries(cse, operands)) b.lower(t);
+    for (Expr t : invariantTemporaries(cse, operands, offset)) b.lower(t);
     b.beginLoop(loopOver(b, block.shape, block.region, base));
     if (!jacobian) b.storeLooped(static_cast<uint32_t>(block.firstRow + base), b.lower(cse.outputs[0]));
     for (size_t e = 0; e < entries.size(); ++e) {
@@ -542,10 +544,25 @@ class Builder {
     return loop;
   }
 
-  // The temporaries whose values read no relative symbol, directly or through other temporaries
-  // (CSE lists a temporary after those it uses).
-  std::vector<Expr> invariantTemporaries(const sym::CseResult& cse, const std::vector<Operand>& operands) {
+  // A template's iterator used as a number (%1, flat::ElementPatterns::iteratorSymbol) in `roots`:
+  // in a 1-D loop over `region` from its first point (L = c), the value first + L, L read with
+  // ldidx. Returns the symbol bound to L (null if no root reads an iterator).
+  Expr iteratorsFromOffset(ProgramBuilder& b, std::vector<Expr>& roots, const flat::Box& region) {
+    if (!dae_.patterns || std::none_of(roots.begin(), roots.end(), [&](Expr r) { return dae_.patterns->readsIterator(ctx_, r); }))
+      return nullptr;
+    QDOT_ASSERT(region.size() == 1, "an iterator's value in a loop of more than one dimension");
+    Expr offset = ctx_.symbol("$L");
+    b.bindLoopOffset(offset);
+    std::unordered_map<Expr, Expr> map{{dae_.patterns->iteratorSymbol(ctx_, 0), ctx_.add(offset, ctx_.constant(double(region[0].first)))}};
+    for (Expr& r : roots) r = ctx_.substitute(r, map);
+    return offset;
+  }
+
+  // The temporaries whose values read no relative symbol (nor the loop offset), directly or through
+  // other temporaries (CSE lists a temporary after those it uses).
+  std::vector<Expr> invariantTemporaries(const sym::CseResult& cse, const std::vector<Operand>& operands, Expr offset = nullptr) {
     std::unordered_set<Expr> variant;
+    if (offset) variant.insert(offset);
     for (const auto& op : operands) variant.insert(op.symbol);
     std::vector<Expr> invariant;
     for (const auto& [t, value] : cse.temporaries) {
@@ -625,7 +642,9 @@ class Builder {
     const dae::Invariant& inv = dae_.invariants[i];
     const flat::IndexedTerm& sum = inv.sums[k];
     std::vector<Operand> operands = reader.read(sum.shape, sum.box, sum.body);
-    sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, std::vector<Expr>{sum.body}, "$s" + std::to_string(i) + "_" + std::to_string(k));
+    std::vector<Expr> body{sum.body};
+    Expr offset = iteratorsFromOffset(b, body, sum.box);
+    sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, body, "$s" + std::to_string(i) + "_" + std::to_string(k));
     b.setSource(addSource("invariant " + inv.name + ": sum over [" + regionText(sum.box) + "] (one loop)", dae_.range));
     std::vector<long> lo;
     for (auto [first, last] : sum.box) lo.push_back(first);
@@ -634,7 +653,7 @@ class Builder {
       b.bindLoopedLoad(op.symbol, op.parameter ? Op::LoadPLooped : op.derivative ? Op::LoadYpLooped : Op::LoadYLooped,
                        static_cast<uint32_t>(op.variable + base + op.offset));
     for (const auto& [t, value] : cse.temporaries) b.bindTemporary(t, value);
-    for (Expr t : invariantTemporaries(cse, operands)) b.lower(t);
+    for (Expr t : invariantTemporaries(cse, operands, offset)) b.lower(t);
     b.beginLoop(loopOver(b, sum.shape, sum.box, base));
     b.storeAdd(i, b.lower(cse.outputs[0]));
     b.endLoop();

@@ -383,6 +383,7 @@ class Deriver {
       bool relative = false;
       for (Expr r : ctx_.freeSymbols(sum.body)) {
         VarRole role = VarRole::Parameter;
+        relative |= m_.patterns->iteratorOf(r) >= 0;  // the body changes from point to point
         if (const flat::RelativeElement* rel = m_.relativeElement(r)) {
           relative = true;
           const flat::ArrayVariable& a = m_.patterns->arrays[rel->array];

@@ -128,10 +128,15 @@ class TemplateDeriver {
     return true;
   }
 
-  // Every relative symbol with its iterator offsets decreased by `by` (indexed by iterator).
+  // Every relative symbol with its iterator offsets decreased by `by` (indexed by iterator), and
+  // every iterator's value %k by by[k] (%k then is the row's subscript: the iterator is %k − by[k]).
   Expr shift(Expr e, const std::vector<long>& by) {
     std::unordered_map<Expr, Expr> map;
     for (Expr s : ctx_.freeSymbols(e)) {
+      if (int k = patterns_.iteratorOf(s); k >= 0 && by[k] != 0) {
+        map.emplace(s, ctx_.add(s, ctx_.constant(-static_cast<double>(by[k]))));
+        continue;
+      }
       const RelativeElement* rel = patterns_.find(s);
       if (!rel) continue;
       RelativeElement moved = *rel;

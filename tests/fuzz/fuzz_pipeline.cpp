@@ -24,10 +24,12 @@ void check(bool ok) {
   if (!ok) __builtin_trap();
 }
 
-void checkDiagnostics(const driver::Compilation& c, size_t size) {
+// Every diagnostic has a message, a known code and, if located, a range inside its own file (the
+// input, or a library the input imports).
+void checkDiagnostics(const driver::Compilation& c) {
   for (const auto& d : c.diags.diagnostics()) {
     check(!d.message.empty() && static_cast<size_t>(d.code) < allDiagCodes().size());
-    if (d.range.valid()) check(d.range.begin <= d.range.end && d.range.end <= size);
+    if (d.range.valid()) check(d.range.begin <= d.range.end && d.range.end <= c.sources.text(d.range.file).size());
   }
   std::ostream null(nullptr);
   c.diags.render(null, c.sources);
@@ -66,7 +68,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   c.options.eliminateAlgebraics = c.options.keepLoops;  // explicit algebraic unknowns solved out
   bool ok = driver::compileSource(c, "fuzz.qd", std::string(reinterpret_cast<const char*>(data), size), "",
                                   driver::Stage::Dae);
-  checkDiagnostics(c, size);
+  checkDiagnostics(c);
   if (!ok) return 0;
   // Square, except for one row per dummy derivative after index reduction.
   check(c.dae->equations.size() == c.dae->variables.size() + c.dae->dummyDerivativeCount());
@@ -79,7 +81,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   for (const auto& b : c.dae->templateBlocks) residuals.push_back(b.residual);
   if (c.ctx.dagSize(residuals) > 5'000) return 0;
   ok = driver::continueTo(c, driver::Stage::Kernel);
-  checkDiagnostics(c, size);
+  checkDiagnostics(c);
   if (!ok) return 0;  // E06xx: what the kernels cannot compute, reported and located
   checkKernels(*c.kernels, c.dae->variables.size());
   check(driver::continueTo(c, driver::Stage::Bytecode) && c.internalError.empty());

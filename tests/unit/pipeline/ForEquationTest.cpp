@@ -241,6 +241,27 @@ void expectScalarFallback(const std::string& text) {
   EXPECT_EQ(loopCount(looped.kernels().program(ModelProgram::Residual)), 0u);
 }
 
+// A heat source whose strength depends on the node, q0·exp(−((i − c)/w)²): the iterator's value in
+// a 1-D loop (from its offset); in a plate (two iterators) the model is compiled as without
+// templates.
+TEST(ForEquations, IteratorsAsNumbersAreOneLoopInOneDimension) {
+  std::string rod = R"(model HeatedRod
+  parameter Integer n = 9;
+  parameter Real a = 1.7, q0 = 3, w = 2;
+  Real T[n](start = {sin(3.14159265358979*i/(n + 1)) for i in 1:n});
+equation
+  der(T[1]) = a*(T[2] - 2*T[1]);
+  for i in 2:n-1 loop
+    der(T[i]) = a*(T[i+1] - 2*T[i] + T[i-1]) + q0*exp(-((i - n/2)/w)^2);
+  end for;
+  der(T[n]) = a*(T[n-1] - 2*T[n]);
+end HeatedRod;
+)";
+  EXPECT_EQ(expectSameKernels(rod, 1), 1u);
+  std::string p = plate("  for i in 2:n-1, j in 2:m-1 loop\n    der(T[i, j]) = a*(T[i+1, j] + T[i-1, j] + T[i, j+1] + T[i, j-1] - 4*T[i, j]) + 0.01*i*j;\n  end for;");
+  expectScalarFallback(p);
+}
+
 // Initial equations that give states their start values (`T[1] = …`, also in a loop) keep the
 // templates, with the same start values and fixed flags; one that is a condition on a derivative
 // is a row of the initialization system, which the structural passes solve on scalars.

@@ -160,6 +160,43 @@ mechanics
   }
 }
 
+// An iterator used as a number (masses 1 + 0.01 i, springs k(1 + 0.1 sin(w i)), a forcing with a
+// phase 0.1 i): the loop computes it from its offset (ldidx), and the rows, the Jacobian and the
+// Jacobi integral are the scalar ones.
+constexpr const char* kGradedChain = R"(model Graded
+  parameter Integer n = 12;
+  parameter Real k = 1000, w = 2;
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+mechanics
+  kinetic = sum(0.5*(1 + 0.01*i)*der(x[i])^2 for i in 1:n);
+  potential = 0.5*k*x[1]^2 + sum(0.5*k*(1 + 0.1*sin(w*i))*(x[i+1] - x[i])^2 + (i + 1)^2*x[i]^4/(2*i) for i in 1:n-1);
+end Graded;
+)";
+
+TEST(LoopedKernels, IteratorsAsNumbersGiveTheScalarResidualJacobianAndInvariants) {
+  EXPECT_EQ(expectSameKernels(kGradedChain), 2u);
+  expectSameInvariants(kGradedChain, 2);
+  std::string forced = kGradedChain;
+  forced.replace(forced.find("end Graded;"), 11, "  for i in 2:n loop\n    force(x[i]) = 2*sin(5*time + 0.1*i);\n  end for;\nend Graded;");
+  EXPECT_EQ(expectSameKernels(forced), 2u);
+  Compiled looped(forced, true);
+  EXPECT_GT(test::opCount(looped.kernels().program(ModelProgram::Residual), kernel::Op::LoadLoopOffset), 0u);
+}
+
+// Where the templates do not apply (here: an equation section), a model whose templates read an
+// iterator as a number is flattened again without them: the very kernels of the scalar lowering.
+TEST(LoopedKernels, IteratorsAsNumbersFallBackToTheScalarLoweringExactly) {
+  std::string text = kGradedChain;
+  text.replace(text.find("mechanics"), 9, "  Real y(start = 1);\nequation\n  der(y) = -y;\nmechanics");
+  Compiled scalar(text, false), looped(text, true);
+  ASSERT_TRUE(scalar.ok && looped.ok) << scalar.diagnostics() << looped.diagnostics();
+  EXPECT_FALSE(looped.c.dae->templated());
+  std::ostringstream a, b;
+  kernel::printKernels(a, scalar.kernels());
+  kernel::printKernels(b, looped.kernels());
+  EXPECT_EQ(a.str(), b.str());
+}
+
 TEST(LoopedKernels, SpringChainGivesTheScalarResidualAndJacobian) {
   size_t loops = expectSameKernels(R"(model Chain
   parameter Integer n = 9;
