@@ -114,13 +114,15 @@ def small_models(build, repeat):
 
 
 # Models whose repeated structure is written other ways than the chain's energies (docs/loops.md):
-# each as templates (qdot run's default) and expanded to scalars (--invariants keeps every stage
-# scalar), at n = 10^5, to t = 1e-4 s.
+# each as templates (qdot run's default) and expanded to scalars (--no-loops), at n = 10^5, to
+# t = 1e-4 s.
 FORMS = [("spring chain, energies", CHAIN, "x[1]"),
          ("non-uniform chain, energies with m[i], k[i]", "examples/vibration/nonuniform_chain.qd", "x[1]"),
          ("spring chain, `m*der(v[i]) = …` equations", "examples/vibration/spring_chain_equations.qd", "x[1]"),
          ("spring chain, link forces f[i] as unknowns", "tests/sim/models/chain_forces.qd", "x[1]"),
-         ("heat rod, `der(T[i]) = …`", "examples/heat/rod.qd", "T[1]")]
+         ("heat rod, `der(T[i]) = …`", "examples/heat/rod.qd", "T[1]"),
+         ("graded chain: index as a number, forces in a loop", "tests/sim/models/graded_forced_chain.qd", "x[1]"),
+         ("heat rod, an initial equation per node", "tests/sim/models/rod_initial_profile.qd", "T[1]")]
 
 
 def forms(build, n, repeat):
@@ -133,7 +135,7 @@ def forms(build, n, repeat):
     print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
     for name, path, column in FORMS:
         cells = []
-        for extra in ([], ["--invariants"]):
+        for extra in ([], ["--no-loops"]):
             command = [f"{build}/qdot", "run", path, "-p", f"n={n}", "--stop", "1e-4", "--interval", "1e-4",
                        "--outputs", column, "-o", "/dev/null", "--stats", "--jit-wait", "--no-progress"] + extra
             best = (float("inf"), float("inf"), float("inf"))

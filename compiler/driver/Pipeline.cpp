@@ -135,14 +135,14 @@ void returnFreedMemory() {
 }
 
 // Whether `for` equations may stay templates (docs/loops.md), from the syntax: a run that keeps
-// loops and needs no invariants, of a model of equations only — no mechanics or components (initial
+// loops, of a model of equations only — no mechanics or components (initial
 // equations that are start values are checked on the flat model) — with `for` loops of equations naming at most one derivative each (`der(x[i]) = …`,
 // `m*der(v[i]) = …`, `f[i] = …`; flat::mayKeepForEquation), one of them naming some. Flattening
 // then keeps them only if each row is matched to its own unknown (dae::isTemplatedOde), else it
 // flattens again.
 bool forEquationsMayStay(const Compilation& c) {
   const sema::CheckedClass& root = *c.checked->root;
-  if (!c.options.keepLoops || c.options.keepInvariants || !root.mechanics.empty()) return false;
+  if (!c.options.keepLoops || !root.mechanics.empty()) return false;  // (no mechanics: no invariants)
   for (const auto& [name, symbol] : root.symbols)
     if (symbol.kind == sema::SymbolKind::Component) return false;
   auto keepable = [](const ast::Equation* eq) { return eq->kind == ast::EquationKind::For && flat::mayKeepForEquation(*eq); };

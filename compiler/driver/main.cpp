@@ -34,6 +34,7 @@ struct Options {
   bool quiet = false;    // check --quiet
   std::string backend = "llvm";
   bool jitWait = false;  // run --jit-wait
+  bool noLoops = false;  // run --no-loops
   rt::RunOptions run;
   driver::WorkPrecisionOptions wp;
   driver::ExecutableOptions exe;
@@ -79,9 +80,8 @@ std::optional<ExitCode> compileToKernels(driver::Compilation& c, Options& o) {
 // --emit=STAGE: compile up to the stage, print its output, stop.
 ExitCode emitStage(driver::Compilation& c, Options& o) {
   driver::EmitStage stage = *driver::parseEmitStage(o.emit);
-  // What `qdot run` compiles, loops included, where the stage shown is past the DAE; with
-  // --invariants, as scalars (the kernels have no reductions), as the run would.
-  c.options.keepLoops = driver::stageNeeded(stage) >= driver::Stage::Kernel;
+  // What `qdot run` compiles, loops included (unless --no-loops), where the stage shown is past the DAE.
+  c.options.keepLoops = driver::stageNeeded(stage) >= driver::Stage::Kernel && !o.noLoops;
   c.options.eliminateAlgebraics = c.options.keepLoops;
   c.options.keepInvariants = o.run.invariants;
   ExitCode failure;
@@ -154,7 +154,7 @@ driver::Backend backendOf(const Options& o) {
 ExitCode run(driver::Compilation& c, Options& o) {
   c.options.results = o.run.outputs;
   c.options.keepInvariants = o.run.invariants;
-  c.options.keepLoops = true;
+  c.options.keepLoops = !o.noLoops;
   c.options.eliminateAlgebraics = true;
   c.options.releaseStages = true;
   if (std::optional<ExitCode> failed = compileToKernels(c, o)) return *failed;
@@ -301,6 +301,9 @@ int main(int argc, char** argv) {
   run->add_flag("--jit-wait", o.jitWait,
                 "with --backend llvm: compile before the first step instead of starting on the VM while the JIT "
                 "compiles in the background (same results either way)");
+  run->add_flag("--no-loops", o.noLoops,
+                "compile every array element on its own instead of keeping repeated structure as loops "
+                "(for comparison and debugging: the results agree to rounding; docs/loops.md)");
   rt::addRunOptions(*run, o.run);
   run->get_option("-p")->description(
       "set a parameter: -p NAME=VALUE (repeatable). Integer parameters are structural (they size arrays): "

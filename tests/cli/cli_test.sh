@@ -147,10 +147,19 @@ contains rows-count "would write 10000000001 rows" "$qdot" run "$src/examples/te
 check max-steps 3 "$qdot" run "$src/examples/textbook/utube.qd" --max-steps 50
 contains max-steps-message "reached --max-steps 50" "$qdot" run "$src/examples/textbook/utube.qd" --max-steps 50
 contains max-steps-rows "rows up to t =" "$qdot" run "$src/examples/textbook/utube.qd" --max-steps 50
-# --emit shows what the run compiles: the rod's `for` equation as one loop, scalar rows with
-# --invariants (the kernels have no reductions, so such a run keeps every stage scalar).
+# --emit shows what the run compiles: the rod's `for` equation as one loop, also with --invariants
+# (the chain's Jacobi integral is a loop of stadd), scalar rows with --no-loops, and the same CSV.
 contains emit-kernel-loop "equations of elements" "$qdot" run "$src/examples/heat/rod.qd" --emit=kernel
-check emit-kernel-invariants-scalar 1 sh -c "'$qdot' run '$src/examples/heat/rod.qd' --emit=kernel --invariants | grep -q 'equations of elements'"
+contains emit-kernel-loop-invariants "equations of elements" "$qdot" run "$src/examples/heat/rod.qd" --emit=kernel --invariants
+contains emit-kernel-jacobi-loop "stadd" "$qdot" run "$src/tests/exe/undamped_chain.qd" --emit=kernel --invariants
+check emit-kernel-no-loops 1 sh -c "'$qdot' run '$src/examples/heat/rod.qd' --emit=kernel --no-loops | grep -q 'equations of elements'"
+"$qdot" run "$src/examples/heat/rod.qd" --backend bytecode --stop 0.1 -o /tmp/qdot_loops.$$ 2>/dev/null
+"$qdot" run "$src/examples/heat/rod.qd" --backend bytecode --stop 0.1 --no-loops -o /tmp/qdot_noloops.$$ 2>/dev/null
+awk -F, 'NR == FNR { row[FNR] = $0; next } FNR == 1 { same = ($0 == row[1]); next }
+         { n = split(row[FNR], a, ","); if (n != NF) same = 0
+           for (i = 1; i <= NF; ++i) { d = $i - a[i]; if (d < 0) d = -d; if (d > 1e-9 * (1 + (a[i] < 0 ? -a[i] : a[i]))) same = 0 } }
+         END { exit !(same && FNR > 2) }' /tmp/qdot_loops.$$ /tmp/qdot_noloops.$$ && pass=$((pass + 1)) || { echo "FAIL no-loops: the rod's CSV differs beyond 1e-9"; fail=$((fail + 1)); }
+rm -f /tmp/qdot_loops.$$ /tmp/qdot_noloops.$$
 # The beating oscillators' six connector flows are defined explicitly by their components' rows:
 # `qdot run` integrates the four states alone and says so; `qdot equations` shows the flows.
 contains stats-solved-out "system: 6 algebraic unknowns" "$qdot" run "$src/examples/vibration/beating.qd" --stop 0.01 -o /dev/null --stats

@@ -621,14 +621,14 @@ TEST(VibrationLibrary, ChainWithLinkForcesMovesAsTheLagrangianChain) {
   expectTheLagrangianChainsMotion("tests/sim/models/chain_forces.qd");
 }
 
-// Expanded to scalars (--invariants keeps every model scalar), the equation chain's rows come in
+// Expanded to scalars (--no-loops), the equation chain's rows come in
 // another order than its unknowns, so the Jacobian's diagonal has structural zeros and KLU must not
 // start with its block triangular form (whose maximum transversal then costs O(n · nnz): 92 s at
 // n = 10⁵). It says so, and it and the looped run move as the Lagrangian chain (n = 300, KLU).
 TEST(VibrationLibrary, AnExpandedEquationChainIsFactoredWithoutBlockTriangularForm) {
   std::vector<std::string> args = {"--rtol", num(kRtol), "-p", "n=300", "--stop", "0.2", "--stats"};
   auto looped = runQdot("examples/vibration/spring_chain_equations.qd", args);
-  args.push_back("--invariants");
+  args.push_back("--no-loops");
   auto scalar = runQdot("examples/vibration/spring_chain_equations.qd", args);
   auto energies = runQdot("examples/vibration/spring_chain.qd", args);
   for (const auto* r : {&looped, &scalar, &energies}) ASSERT_EQ(r->exitCode, 0) << r->log;
