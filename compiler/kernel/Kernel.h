@@ -105,6 +105,11 @@ std::string describeLocation(const SourceManager& sm, SourceRange r);
 /// of p (ldpl).
 std::string checkLoops(const Program& p, size_t variableCount, size_t parameterCount);
 
+/// Moves the constant loads (`ldk`) of every loop body before its `loop`, one per constant: a body
+/// runs them once instead of once per iteration (the JIT folds them anyway; the VM does not).
+/// Registers are renumbered; what the program computes is unchanged.
+void hoistLoopConstants(Program& p);
+
 /// Instructions one run of `p` executes: a loop body's count times, the rest once.
 uint64_t executedInstructions(const Program& p);
 

@@ -2,6 +2,8 @@
 // for the backends that do not go through the bytecode validator (the JIT and object files compile
 // the kernel directly, and a looped store outside its outputs would write out of bounds), and
 // executedInstructions, the work of one call.
+#include <unordered_map>
+
 #include "kernel/Kernel.h"
 
 namespace qdot::kernel {
@@ -87,6 +89,43 @@ class LoopChecker {
 
 std::string checkLoops(const Program& p, size_t variableCount, size_t parameterCount) {
   return LoopChecker(p, variableCount, parameterCount).check();
+}
+
+void hoistLoopConstants(Program& p) {
+  if (p.loops.empty()) return;
+  std::vector<Instr> code;
+  code.reserve(p.code.size());
+  std::vector<uint32_t> renamed(p.code.size(), kNone);  // old register -> new
+  auto rename = [&](Instr ins) {
+    for (uint32_t k = 0; k < readCount(ins.op); ++k) {
+      uint32_t& r = k == 0 ? ins.a : k == 1 ? ins.b : ins.c;
+      r = renamed[r];
+    }
+    return ins;
+  };
+  for (size_t i = 0; i < p.code.size(); ++i) {
+    if (p.code[i].op != Op::LoopBegin) {
+      renamed[i] = static_cast<uint32_t>(code.size());
+      code.push_back(rename(p.code[i]));
+      continue;
+    }
+    size_t end = i + 1;
+    while (p.code[end].op != Op::LoopEnd) ++end;
+    std::unordered_map<uint32_t, uint32_t> hoisted;  // pool index -> new register
+    for (size_t j = i + 1; j < end; ++j)
+      if (p.code[j].op == Op::LoadConst) {
+        auto [at, fresh] = hoisted.try_emplace(p.code[j].imm, static_cast<uint32_t>(code.size()));
+        if (fresh) code.push_back(p.code[j]);
+        renamed[j] = at->second;
+      }
+    for (size_t j = i; j <= end; ++j) {
+      if (j > i && j < end && p.code[j].op == Op::LoadConst) continue;
+      renamed[j] = static_cast<uint32_t>(code.size());
+      code.push_back(rename(p.code[j]));
+    }
+    i = end;
+  }
+  p.code = std::move(code);
 }
 
 uint64_t executedInstructions(const Program& p) {

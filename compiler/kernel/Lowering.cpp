@@ -257,6 +257,7 @@ uint32_t ProgramBuilder::power(uint32_t base, double v) {
 
 Program ProgramBuilder::finish(uint32_t outputCount) {
   program_.outputCount = outputCount;
+  hoistLoopConstants(program_);
   return std::move(program_);
 }
 

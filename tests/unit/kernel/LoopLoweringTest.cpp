@@ -61,10 +61,14 @@ TEST_F(LoopLowering, StencilTemplateInALoopBody) {
   EXPECT_EQ(b.lower(k), kReg);
   EXPECT_EQ(count(p, Op::LoadP), 1u);  // k: once, before the loop, used inside and after
   EXPECT_EQ(count(p, Op::Mul), 4u);  // k*k, -2*u[i], (k*k)*(...) in the body, k*k again after it
-  EXPECT_EQ(count(p, Op::LoadConst), 3u);  // -2 and 3 in the body, 3 again after it
+  EXPECT_EQ(count(p, Op::LoadConst), 3u);  // -2 and 3 for the body, 3 again after it
   EXPECT_EQ(p.constants.size(), 2u);       // ... sharing the pool entry
   ASSERT_EQ(p.loops.size(), 1u);
-  EXPECT_EQ(p.code[kReg + 1].op, Op::LoopBegin);
+  // The body's constants are loaded once, between k and the loop (hoistLoopConstants).
+  EXPECT_EQ(p.code[kReg + 1].op, Op::LoadConst);
+  EXPECT_EQ(p.code[kReg + 2].op, Op::LoadConst);
+  EXPECT_EQ(p.code[kReg + 3].op, Op::LoopBegin);
+  for (size_t i = kReg + 4; p.code[i].op != Op::LoopEnd; ++i) EXPECT_NE(p.code[i].op, Op::LoadConst) << i;
 
   std::vector<double> y = {0.3, -1.2, 2.5, 0.7, -0.1, 1.9, -2.2, 0.4, 1.1}, F(n, -7.0);
   double kv = 1.7;
@@ -75,6 +79,51 @@ TEST_F(LoopLowering, StencilTemplateInALoopBody) {
   }
   EXPECT_EQ(F[0], kv * kv + 3.0);
   EXPECT_EQ(F[n - 1], kv);
+}
+
+// hoistLoopConstants on a hand-written program: two loops whose bodies load the same constants
+// (one of them twice) and a select reading three registers; the constants move before each loop,
+// once per loop, every operand is renamed, and the program computes the same bits.
+TEST_F(LoopLowering, HoistedConstantsComputeTheSameBits) {
+  using kernel::Instr;
+  kernel::Program p;
+  p.name = "residual";
+  p.constants = {0.5, -3.0};
+  p.loops = {kernel::Loop{.count = 4}, kernel::Loop{.count = 3, .first = 1, .stride = 1}};
+  p.outputCount = 8;
+  p.code = {Instr{Op::LoadP, 0, 0, 0, 0},          // %0 = p[0]
+            Instr{Op::LoopBegin, 0, 0, 0, 0},      // loop 0
+            Instr{Op::LoadYLooped, 0, 0, 0, 0},    // %2 = y[L]
+            Instr{Op::LoadConst, 0, 0, 0, 0},      // %3 = 0.5
+            Instr{Op::Mul, 2, 3, 0, 0},            // %4
+            Instr{Op::LoadConst, 0, 0, 0, 1},      // %5 = -3
+            Instr{Op::LoadConst, 0, 0, 0, 0},      // %6 = 0.5 again
+            Instr{Op::Select, 4, 5, 6, 0},         // %7 = %4 ? -3 : 0.5
+            Instr{Op::Add, 7, 0, 0, 0},            // %8 = %7 + p[0]
+            Instr{Op::StoreLooped, 8, 0, 0, 0},    // out[L]
+            Instr{Op::LoopEnd, 0, 0, 0, 0},
+            Instr{Op::LoopBegin, 0, 0, 0, 1},      // loop 1
+            Instr{Op::LoadConst, 0, 0, 0, 1},      // %12 = -3
+            Instr{Op::LoadYLooped, 0, 0, 0, 0},    // %13 = y[L]
+            Instr{Op::Mul, 12, 13, 0, 0},          // %14
+            Instr{Op::StoreLooped, 14, 0, 0, 4},   // out[4 + L]
+            Instr{Op::LoopEnd, 0, 0, 0, 1}};
+  ASSERT_EQ(kernel::checkLoops(p, 4, 1), "");
+  std::vector<double> y = {0.0, 2.0, -1.5, 0.25}, before(8, -1.0), after(8, -1.0);
+  double pv = 0.75;
+  kernel::interpret(p, {.y = y.data(), .p = &pv}, before);
+  kernel::Program hoisted = p;
+  kernel::hoistLoopConstants(hoisted);
+  EXPECT_EQ(kernel::checkLoops(hoisted, 4, 1), "");
+  kernel::interpret(hoisted, {.y = y.data(), .p = &pv}, after);
+  for (size_t k = 0; k < 8; ++k) EXPECT_EQ(std::bit_cast<uint64_t>(after[k]), std::bit_cast<uint64_t>(before[k])) << k;
+  EXPECT_EQ(count(hoisted, Op::LoadConst), 3u);  // 0.5 and -3 before loop 0, -3 before loop 1
+  bool inBody = false;
+  for (const auto& ins : hoisted.code) {
+    inBody = ins.op == Op::LoopBegin || (inBody && ins.op != Op::LoopEnd);
+    EXPECT_FALSE(inBody && ins.op == Op::LoadConst);
+  }
+  EXPECT_LT(kernel::executedInstructions(hoisted), kernel::executedInstructions(p));
 }
 
 // Start values 0.01*i over a table loop, stored through a permutation (stx).
@@ -119,7 +168,7 @@ TEST_F(LoopLowering, CheckLoopsAndExecutedInstructions) {
   auto build = [&](uint32_t count, int32_t first) { return doubledInLoop(Op::LoadYLooped, 1, count, first); };
   kernel::Program p = build(3, 0);  // y[1 + L], L = 0..2: y[1..3]; out[0..2]
   EXPECT_EQ(kernel::checkLoops(p, 4, 0), "");
-  EXPECT_EQ(kernel::executedInstructions(p), 2 + 3u * 4);  // loop, endloop; 3 x (ldk, ldyl, mul, stl)
+  EXPECT_EQ(kernel::executedInstructions(p), 3 + 3u * 3);  // ldk (hoisted), loop, endloop; 3 x (ldyl, mul, stl)
   EXPECT_NE(kernel::checkLoops(build(4, 0), 4, 0).find("ldyl index out of range"), std::string::npos);  // y[4]
   EXPECT_NE(kernel::checkLoops(build(3, -2), 4, 0).find("index out of range"), std::string::npos);      // y[-1]
   EXPECT_EQ(kernel::checkLoops(build(0, -9), 4, 0), "");  // no iteration reaches anything
