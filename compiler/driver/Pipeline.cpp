@@ -99,21 +99,83 @@ bool loopsReadForce(const flat::FlatModel& m, const flat::IndexedForce& f, const
 }
 
 // Where the stages after flattening take templates (docs/loops.md): a model of energies over
-// coordinates only — no equations, constraints, components or aliases (their structural passes
-// work on scalars), initial equations that are start values at most. Its Jacobi integral is a
+// coordinates only — no constraints, components or aliases (their structural passes work on
+// scalars), equations only where they define algebraic unknowns explicitly, initial equations that
+// are start values at most. Its Jacobi integral is a
 // sum over every element: the kernels loop it too.
-bool templatesApply(const flat::FlatModel& m, const CompileOptions& o, const sym::Context& ctx) {
+// `defined`: the algebraic unknowns the model's equations define explicitly (explicitDefinitions),
+// which become outputs: the equations may be those definitions.
+bool templatesApply(const flat::FlatModel& m, const CompileOptions& o, const sym::Context& ctx,
+                    const std::vector<int>& defined) {
   if (!o.keepLoops || (m.indexedSums.empty() && m.indexedForces.empty())) return false;
-  if (!m.equations.empty() || !m.constraints.empty() || m.components.size() > 1) return false;
+  if (m.equations.size() != defined.size() || !m.constraints.empty() || m.components.size() > 1) return false;
   if (!dae::initialEquationsAreStartValues(m, ctx)) return false;
-  bool plain = std::none_of(m.variables.begin(), m.variables.end(), [](const flat::Variable& v) {
-    return v.alias || v.role == flat::VarRole::Unknown || v.role == flat::VarRole::Derivative;
-  });
+  std::vector<char> isDefined(m.variables.size(), 0);
+  for (int z : defined) isDefined[z] = 1;
+  bool plain = true;
+  for (size_t v = 0; v < m.variables.size(); ++v) {
+    const flat::Variable& var = m.variables[v];
+    plain &= !var.alias && var.role != flat::VarRole::Derivative && (var.role != flat::VarRole::Unknown || isDefined[v]);
+  }
   return plain &&
          std::all_of(m.indexedSums.begin(), m.indexedSums.end(),
                      [&](const flat::IndexedSum& sum) { return loopsRead(m, sum.body, sum.box.size(), nullptr, ctx); }) &&
          std::all_of(m.indexedForces.begin(), m.indexedForces.end(),
                      [&](const flat::IndexedForce& f) { return loopsReadForce(m, f, ctx); });
+}
+
+// The equations of a model of energies that each define an algebraic unknown explicitly — `z =
+// expr` or `expr = z`, expr over coordinates, velocities, parameters and time — one per unknown,
+// every unknown of the model so defined: per equation, the unknown it defines; nullopt otherwise.
+// (What dae::eliminateExplicitAlgebraics would solve out of the scalar DAE; with templates they
+// become outputs before the stages that need every row.)
+std::optional<std::vector<int>> explicitDefinitions(const flat::FlatModel& m, const sym::Context& ctx) {
+  using flat::VarRole;
+  auto definable = [&](sym::Expr s) {
+    int v = m.variableOf(s);
+    if (v < 0) return -1;
+    const flat::Variable& var = m.variables[v];
+    bool algebraic = var.role == VarRole::Unknown && var.derivative < 0 && !var.alias;
+    return algebraic && !(var.fixed && var.fixedGiven) ? v : -1;
+  };
+  auto overStates = [&](sym::Expr e) {
+    for (sym::Expr s : ctx.freeSymbols(e)) {
+      int v = m.variableOf(s);
+      VarRole r = v >= 0 ? m.variables[v].role : VarRole::Unknown;
+      if (r != VarRole::Coordinate && r != VarRole::Velocity && r != VarRole::Parameter && r != VarRole::Time) return false;
+    }
+    return true;
+  };
+  std::vector<int> defined;
+  std::vector<char> seen(m.variables.size(), 0);
+  for (const flat::Equation& e : m.equations) {
+    if (e.origin.kind != flat::OriginKind::Equation || !e.lhs || !e.rhs) return std::nullopt;
+    int z = definable(e.lhs);
+    if (z < 0 || !overStates(e.rhs)) z = overStates(e.lhs) ? definable(e.rhs) : -1;
+    if (z < 0 || seen[z]++) return std::nullopt;
+    defined.push_back(z);
+  }
+  for (size_t v = 0; v < m.variables.size(); ++v)
+    if (m.variables[v].role == VarRole::Unknown && !m.variables[v].alias && !seen[v]) return std::nullopt;
+  return defined;
+}
+
+// The explicitly defined unknowns leave the system: each an alias of its value (the DAE
+// substitutes it wherever it is read, a force say) and an output, first among the outputs in the
+// order of the unknowns, as dae::eliminateExplicitAlgebraics places them.
+void defineAsOutputs(flat::FlatModel& m, const std::vector<int>& defined) {
+  std::vector<std::pair<int, size_t>> order;  // (unknown, its equation)
+  for (size_t e = 0; e < defined.size(); ++e) order.push_back({defined[e], e});
+  std::sort(order.begin(), order.end());
+  std::vector<flat::Output> outputs;
+  for (auto [z, e] : order) {
+    const flat::Equation& eq = m.equations[e];
+    sym::Expr value = m.variableOf(eq.lhs) == z ? eq.rhs : eq.lhs;
+    m.variables[z].alias = value;
+    outputs.push_back({std::string(m.variables[z].name), value, eq.origin.range, flat::OutputKind::Plain});
+  }
+  m.outputs.insert(m.outputs.begin(), outputs.begin(), outputs.end());
+  m.equations.clear();
 }
 
 // Whether a template of the model reads an iterator as a number (`0.1*i`): expanded, it is equal
@@ -172,7 +234,14 @@ bool flatten(Compilation& c) {
     if (forEquationsMayStay(c))
       if (auto model = flattenKeepingEquations(c, limits)) return model;
     auto model = flat::flatten(*c.checked, c.ctx, c.diags, limits, c.options.structural);
-    if (model && !templatesApply(*model, c.options, c.ctx)) {
+    std::optional<std::vector<int>> defined;
+    if (model) defined = model->equations.empty() ? std::vector<int>{} : explicitDefinitions(*model, c.ctx);
+    bool templates = model && defined && templatesApply(*model, c.options, c.ctx, *defined);
+    if (templates && !defined->empty()) {
+      defineAsOutputs(*model, *defined);
+      c.eliminated.eliminated = defined->size();  // solved out as the scalar DAE would have them
+    }
+    if (model && !templates) {
       if (!readsIterators(*model, c.ctx) || c.diags.hasErrors()) {
         flat::expandIndexedSums(*model, c.ctx);  // exactly the scalar lowering's nodes
       } else {  // an iterator's value folds in another order than the scalar lowering's: flatten again

@@ -16,12 +16,14 @@
 
 namespace qdot::test {
 
-/// `text` compiled to kernels, keeping its repeated structure as loops or not.
+/// `text` compiled to kernels, keeping its repeated structure as loops or not (and solving explicit
+/// algebraic unknowns out of the system, as `qdot run` does, or not).
 struct CompiledKernels {
   driver::Compilation c;
   bool ok = false;
-  CompiledKernels(const std::string& text, bool loops) {
+  CompiledKernels(const std::string& text, bool loops, bool eliminateAlgebraics = false) {
     c.options.keepLoops = loops;
+    c.options.eliminateAlgebraics = eliminateAlgebraics;
     ok = driver::compileSource(c, "model.qd", text, driver::Stage::Kernel);
   }
   const kernel::KernelModule& kernels() const { return *c.kernels; }
@@ -47,7 +49,7 @@ using GivenParameters = std::vector<std::pair<std::string, double>>;
 /// The residual F, the Jacobian's values J (CSC order), the invariants and the initial values
 /// (y0, y'0, nominal) of a kernel module.
 struct KernelValues {
-  std::vector<double> F, J, invariants, start;
+  std::vector<double> F, J, invariants, start, outputs;
 };
 
 /// F, J and the invariants at trial state `trial` (y, y', cj and t fixed by it), with the default parameter values
@@ -75,6 +77,8 @@ inline KernelValues evaluateAt(const kernel::KernelModule& k, int trial, const G
   kernel::interpret(k.program(ModelProgram::Residual), in, v.F);
   kernel::interpret(k.program(ModelProgram::Jacobian), in, v.J);
   kernel::interpret(k.program(ModelProgram::Invariants), in, v.invariants);
+  v.outputs.resize(k.description.outputNames.size());
+  kernel::interpret(k.program(ModelProgram::Outputs), in, v.outputs);
   v.start.resize(3 * n);
   kernel::interpret(k.program(ModelProgram::InitialValues), ModelCall{.t = 0.0, .p = p.data()}, v.start);
   return v;

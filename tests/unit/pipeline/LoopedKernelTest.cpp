@@ -17,7 +17,9 @@ namespace {
 using test::loopCount;
 
 struct Compiled : test::CompiledKernels {
-  Compiled(const std::string& text, bool loops) : CompiledKernels(text, loops) { EXPECT_TRUE(ok) << diagnostics(); }
+  Compiled(const std::string& text, bool loops, bool eliminate = false) : CompiledKernels(text, loops, eliminate) {
+    EXPECT_TRUE(ok) << diagnostics();
+  }
 };
 
 // Residual and Jacobian of both at a few random states (parameters at their defaults except those
@@ -195,6 +197,47 @@ TEST(LoopedKernels, IteratorsAsNumbersFallBackToTheScalarLoweringExactly) {
   kernel::printKernels(a, scalar.kernels());
   kernel::printKernels(b, looped.kernels());
   EXPECT_EQ(a.str(), b.str());
+}
+
+// Equations that define algebraic unknowns explicitly (a link's tension, a push that a force
+// reads) next to the energies: with templates they become outputs before mechanics, as
+// `qdot run` solves them out of the scalar system — the same unknowns, outputs (in the same
+// order), rows and Jacobian. An equation that is not such a definition keeps the model scalar.
+constexpr const char* kChainWithDefinitions = R"(model Defined
+  parameter Integer n = 12;
+  parameter Real k = 1000;
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+  Real tension "force in the first link [N]";
+  Real push;
+  output Real ends = x[n] - x[1];
+mechanics
+  kinetic = sum(0.5*der(x[i])^2 for i in 1:n);
+  potential = 0.5*k*x[1]^2 + sum(0.5*k*(x[i+1] - x[i])^2 for i in 1:n-1);
+  force(x[n]) = -push;
+equation
+  tension = k*(x[2] - x[1]);
+  2*sin(time) + 0.1*der(x[n]) = push;
+end Defined;
+)";
+
+TEST(LoopedKernels, ExplicitDefinitionsBecomeOutputsAndKeepTheLoops) {
+  Compiled scalar(kChainWithDefinitions, false, true), looped(kChainWithDefinitions, true, true);
+  const kernel::KernelModule &a = scalar.kernels(), &b = looped.kernels();
+  EXPECT_EQ(loopCount(b.program(ModelProgram::Residual)), 2u);
+  EXPECT_EQ(a.description.variableNames, b.description.variableNames);
+  EXPECT_EQ(b.description.outputNames, (std::vector<std::string>{"tension", "push", "ends"}));
+  EXPECT_EQ(a.description.outputNames, b.description.outputNames);
+  EXPECT_EQ(a.description.jacobianRowIndices, b.description.jacobianRowIndices);
+  for (int trial = 0; trial < 3; ++trial) {
+    test::KernelValues va = test::evaluateAt(a, trial), vb = test::evaluateAt(b, trial);
+    for (size_t i = 0; i < va.F.size(); ++i) EXPECT_NEAR(vb.F[i], va.F[i], 1e-13 * (1 + std::abs(va.F[i]))) << "F[" << i << "]";
+    for (size_t i = 0; i < va.J.size(); ++i) EXPECT_NEAR(vb.J[i], va.J[i], 1e-13 * (1 + std::abs(va.J[i]))) << "J[" << i << "]";
+    for (size_t i = 0; i < va.outputs.size(); ++i) EXPECT_NEAR(vb.outputs[i], va.outputs[i], 1e-13 * (1 + std::abs(va.outputs[i])));
+  }
+  std::string implicit = kChainWithDefinitions;
+  implicit.replace(implicit.find("tension = k*"), 12, "tension^3 = k*");
+  Compiled stays(implicit, true, true);
+  EXPECT_FALSE(stays.c.dae->templated());
 }
 
 TEST(LoopedKernels, SpringChainGivesTheScalarResidualAndJacobian) {
