@@ -509,16 +509,7 @@ class Builder {
     Expr offset = iteratorsFromOffset(b, roots, block.region);
     sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, roots, "$b" + std::to_string(k) + (jacobian ? "j" : "r"));
     b.setSource(blockSource(k));
-    std::vector<long> lo;
-    for (auto [first, last] : block.region) lo.push_back(first);
-    long base = flat::linearIndex(block.shape, lo);
-    const std::vector<Operand>& operands = jac.templateOperands[k];
-    for (const auto& op : operands)
-      b.bindLoopedLoad(op.symbol, op.parameter ? Op::LoadPLooped : op.derivative ? Op::LoadYpLooped : Op::LoadYLooped,
-                       static_cast<uint32_t>(op.variable + base + op.offset));
-    for (const auto& [t, value] : cse.temporaries) b.bindTemporary(t, value);
-    for (Expr t : invariantTemporaries(cse, operands, offset)) b.lower(t);
-    b.beginLoop(loopOver(b, block.shape, block.region, base));
+    long base = openLoop(b, cse, jac.templateOperands[k], offset, block.shape, block.region);
     if (!jacobian) b.storeLooped(static_cast<uint32_t>(block.firstRow + base), b.lower(cse.outputs[0]));
     for (size_t e = 0; e < entries.size(); ++e) {
       b.storeIndexed(b.appendIndexTable(entries[e]->positions), b.lower(cse.outputs[e]));
@@ -528,6 +519,23 @@ class Builder {
   }
 
   using Operand = TemplateOperand;
+
+  // Opens the loop of a template over `region` (arrays of `shape`): its operands as loads from the
+  // region's first point on, its CSE temporaries bound, those that read nothing per iteration (no
+  // operand, not the loop offset) lowered before the loop. Returns that first point's linear index.
+  long openLoop(ProgramBuilder& b, const sym::CseResult& cse, const std::vector<Operand>& operands, Expr offset,
+                const std::vector<int>& shape, const flat::Box& region) {
+    std::vector<long> lo;
+    for (auto [first, last] : region) lo.push_back(first);
+    long base = flat::linearIndex(shape, lo);
+    for (const auto& op : operands)
+      b.bindLoopedLoad(op.symbol, op.parameter ? Op::LoadPLooped : op.derivative ? Op::LoadYpLooped : Op::LoadYLooped,
+                       static_cast<uint32_t>(op.variable + base + op.offset));
+    for (const auto& [t, value] : cse.temporaries) b.bindTemporary(t, value);
+    for (Expr t : invariantTemporaries(cse, operands, offset)) b.lower(t);
+    b.beginLoop(loopOver(b, shape, region, base));
+    return base;
+  }
 
   // Row-major points of the region as offsets from its first point: an affine loop in one
   // dimension, a table of offsets in more.
@@ -646,15 +654,7 @@ class Builder {
     Expr offset = iteratorsFromOffset(b, body, sum.box);
     sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, body, "$s" + std::to_string(i) + "_" + std::to_string(k));
     b.setSource(addSource("invariant " + inv.name + ": sum over [" + regionText(sum.box) + "] (one loop)", dae_.range));
-    std::vector<long> lo;
-    for (auto [first, last] : sum.box) lo.push_back(first);
-    long base = flat::linearIndex(sum.shape, lo);
-    for (const auto& op : operands)
-      b.bindLoopedLoad(op.symbol, op.parameter ? Op::LoadPLooped : op.derivative ? Op::LoadYpLooped : Op::LoadYLooped,
-                       static_cast<uint32_t>(op.variable + base + op.offset));
-    for (const auto& [t, value] : cse.temporaries) b.bindTemporary(t, value);
-    for (Expr t : invariantTemporaries(cse, operands, offset)) b.lower(t);
-    b.beginLoop(loopOver(b, sum.shape, sum.box, base));
+    openLoop(b, cse, operands, offset, sum.shape, sum.box);
     b.storeAdd(i, b.lower(cse.outputs[0]));
     b.endLoop();
   }

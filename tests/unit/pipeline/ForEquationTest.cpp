@@ -229,17 +229,7 @@ end EquationChain;
 )", 2), 2u);
 }
 
-// Compiled with templates allowed, the model is compiled exactly as without: same kernels, no loop.
-void expectScalarFallback(const std::string& text) {
-  Compiled scalar(text, false), looped(text, true);
-  ASSERT_TRUE(scalar.ok && looped.ok) << scalar.diagnostics() << looped.diagnostics();
-  EXPECT_FALSE(looped.c.dae->templated());
-  std::ostringstream a, b;
-  kernel::printKernels(a, scalar.kernels());
-  kernel::printKernels(b, looped.kernels());
-  EXPECT_EQ(a.str(), b.str());
-  EXPECT_EQ(loopCount(looped.kernels().program(ModelProgram::Residual)), 0u);
-}
+using test::expectScalarFallback;
 
 // A heat source whose strength depends on the node, q0·exp(−((i − c)/w)²): the iterator's value in
 // a 1-D loop (from its offset); in a plate (two iterators) the model is compiled as without

@@ -289,6 +289,12 @@ TEST(TemplateRows, ChainInteriorIsOneTemplateAndEqualsTheScalarRows) {
   EXPECT_EQ(rows[0].region, (std::vector<std::pair<long, long>>{{2, 5}}));
 }
 
+// The equations of motion of both flattenings.
+std::pair<std::optional<mech::EquationsOfMotion>, std::optional<mech::EquationsOfMotion>> deriveBoth(test::SourceDae& s,
+                                                                                                      Flattened& f) {
+  return {mech::deriveEquationsOfMotion(*f.scalar, s.ctx, s.diags), mech::deriveEquationsOfMotion(*f.templated, s.ctx, s.diags)};
+}
+
 // First integrals with templates. Reference: the scalar derivation of the same model. The free end
 // x[n] of the undamped chain is in no scalar term but in the springs' sum: not cyclic (its momentum
 // changes whenever the last spring is stretched), which the templated derivation once missed; the
@@ -308,8 +314,7 @@ end Undamped;
 )", driver::Stage::Check);
   Flattened f = flattenBoth(s);
   ASSERT_TRUE(f.scalar && f.templated);
-  auto scalar = mech::deriveEquationsOfMotion(*f.scalar, s.ctx, s.diags);
-  auto templated = mech::deriveEquationsOfMotion(*f.templated, s.ctx, s.diags);
+  auto [scalar, templated] = deriveBoth(s, f);
   ASSERT_TRUE(scalar && templated);
   ASSERT_FALSE(templated->templateRows.empty());
   auto names = [](const mech::EquationsOfMotion& e) {
@@ -346,8 +351,7 @@ end Free;
 )", driver::Stage::Check);
   Flattened f = flattenBoth(s);
   ASSERT_TRUE(f.scalar && f.templated);
-  auto scalar = mech::deriveEquationsOfMotion(*f.scalar, s.ctx, s.diags);
-  auto templated = mech::deriveEquationsOfMotion(*f.templated, s.ctx, s.diags);
+  auto [scalar, templated] = deriveBoth(s, f);
   ASSERT_TRUE(scalar && templated);
   std::vector<std::string> names;
   for (const auto& i : templated->integrals) names.push_back(i.name);

@@ -35,6 +35,22 @@ struct CompiledKernels {
 };
 
 /// How many instructions of `p` are `op`.
+inline size_t opCount(const kernel::Program& p, kernel::Op op);
+
+/// Compiled with templates allowed, the model is compiled exactly as without: the same kernels,
+/// byte for byte, and no loop in the residual.
+inline void expectScalarFallback(const std::string& text) {
+  CompiledKernels scalar(text, false), looped(text, true);
+  ASSERT_TRUE(scalar.ok && looped.ok) << scalar.diagnostics() << looped.diagnostics();
+  EXPECT_FALSE(looped.c.dae->templated());
+  std::ostringstream a, b;
+  kernel::printKernels(a, scalar.kernels());
+  kernel::printKernels(b, looped.kernels());
+  EXPECT_EQ(a.str(), b.str());
+  EXPECT_EQ(opCount(looped.kernels().program(ModelProgram::Residual), kernel::Op::LoopBegin), 0u);
+}
+
+/// How many instructions of `p` are `op`.
 inline size_t opCount(const kernel::Program& p, kernel::Op op) {
   size_t n = 0;
   for (const auto& i : p.code) n += i.op == op;
