@@ -36,6 +36,24 @@ TEST(HeatRod, DecaysAsTheFirstModeOfTheSemiDiscreteSystem) {
   }
 }
 
+// The same rod with its start profile given by an initial equation per node (a `for` loop of start
+// values, tests/sim/models/rod_initial_profile.qd, whose loop ForEquationTest shows kept): the same
+// exact solution, within the same bound.
+TEST(HeatRod, AStartProfileByInitialEquationsDecaysAsTheFirstMode) {
+  const int n = 50;
+  const double a = 1, pi = 3.14159265358979, rtol = 1e-7;
+  const double lambda = 4 * a * std::pow(std::sin(pi / (2 * (n + 1))), 2);
+  auto r = runQdot("tests/sim/models/rod_initial_profile.qd", {"--rtol", num(rtol)});
+  ASSERT_EQ(r.exitCode, 0) << r.log;
+  expectGrid(r, 0, 200, 10);
+  for (int i = 1; i <= n; ++i) {
+    double shape = std::sin(pi * i / (n + 1));
+    compareColumn(
+        r, "T[" + std::to_string(i) + "]", [&](double t) { return shape * std::exp(-lambda * t); },
+        [&](double) { return 2 * rtol; });
+  }
+}
+
 // The same rod as an energy balance per node, C T_i' = G (…) (tests/sim/models/rod_capacities.qd,
 // n = 40): rows that name their derivative with a factor stay one loop, and the decay rate is
 // G/C times the rod's, λ = 4 (G/C) sin²(π/(2(n + 1))). Bound as above.
