@@ -122,10 +122,7 @@ class OdeCheck {
         if (!indexedInOrder(*rel, t.box.size()) || !shaped || firstUnknown(rel->array) < 0) return -1;
         continue;
       }
-      if (m_.patterns->iteratorOf(other) >= 0) {  // the iterator's value: 1-D loops compute it
-        if (t.box.size() != 1) return -1;
-        continue;
-      }
+      if (m_.patterns->iteratorOf(other) >= 0) continue;  // an iterator's value: the loop gives it
       int v = m_.variableOf(other);
       if (v < 0 || (m_.variables[v].role != VarRole::Parameter && m_.variables[v].role != VarRole::Time)) return -1;
     }

@@ -69,11 +69,9 @@ bool check(Compilation& c) {
 // Whether every relative symbol of a template's body is one the loops read: an array of
 // coordinates or velocities, or an array of parameters a loop addresses as p[first + linear index]
 // (flat::loopableParameters; in several dimensions of the shape of the coordinates the template
-// reads); an iterator used as a number only in one dimension (a loop computes it from its offset).
-// `shape`: the coordinates' shape if known (a force's target), else null.
+// reads). `shape`: the coordinates' shape if known (a force's target), else null.
 bool loopsRead(const flat::FlatModel& m, sym::Expr body, size_t rank, const std::vector<int>* shape,
                const sym::Context& ctx) {
-  if (rank > 1 && m.patterns->readsIterator(ctx, body)) return false;  // an iterator's value: 1-D loops only
   std::vector<const flat::RelativeElement*> parameters;
   for (sym::Expr s : ctx.freeSymbols(body)) {
     const flat::RelativeElement* rel = m.relativeElement(s);

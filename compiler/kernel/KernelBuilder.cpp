@@ -506,10 +506,10 @@ class Builder {
     for (TemplateEntry& e : jac.templateEntries)
       if (jacobian && e.block == static_cast<int>(k)) roots.push_back(e.value), entries.push_back(&e);
     if (roots.empty()) return;
-    Expr offset = iteratorsFromOffset(b, roots, block.region);
+    std::vector<Expr> perIteration = iteratorsFromOffset(b, roots, block.region);
     sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, roots, "$b" + std::to_string(k) + (jacobian ? "j" : "r"));
     b.setSource(blockSource(k));
-    long base = openLoop(b, cse, jac.templateOperands[k], offset, block.shape, block.region);
+    long base = openLoop(b, cse, jac.templateOperands[k], perIteration, block.shape, block.region);
     if (!jacobian) b.storeLooped(static_cast<uint32_t>(block.firstRow + base), b.lower(cse.outputs[0]));
     for (size_t e = 0; e < entries.size(); ++e) {
       b.storeIndexed(b.appendIndexTable(entries[e]->positions), b.lower(cse.outputs[e]));
@@ -523,8 +523,8 @@ class Builder {
   // Opens the loop of a template over `region` (arrays of `shape`): its operands as loads from the
   // region's first point on, its CSE temporaries bound, those that read nothing per iteration (no
   // operand, not the loop offset) lowered before the loop. Returns that first point's linear index.
-  long openLoop(ProgramBuilder& b, const sym::CseResult& cse, const std::vector<Operand>& operands, Expr offset,
-                const std::vector<int>& shape, const flat::Box& region) {
+  long openLoop(ProgramBuilder& b, const sym::CseResult& cse, const std::vector<Operand>& operands,
+                const std::vector<Expr>& perIteration, const std::vector<int>& shape, const flat::Box& region) {
     std::vector<long> lo;
     for (auto [first, last] : region) lo.push_back(first);
     long base = flat::linearIndex(shape, lo);
@@ -532,7 +532,7 @@ class Builder {
       b.bindLoopedLoad(op.symbol, op.parameter ? Op::LoadPLooped : op.derivative ? Op::LoadYpLooped : Op::LoadYLooped,
                        static_cast<uint32_t>(op.variable + base + op.offset));
     for (const auto& [t, value] : cse.temporaries) b.bindTemporary(t, value);
-    for (Expr t : invariantTemporaries(cse, operands, offset)) b.lower(t);
+    for (Expr t : invariantTemporaries(cse, operands, perIteration)) b.lower(t);
     b.beginLoop(loopOver(b, shape, region, base));
     return base;
   }
@@ -552,25 +552,38 @@ class Builder {
     return loop;
   }
 
-  // A template's iterator used as a number (%1, flat::ElementPatterns::iteratorSymbol) in `roots`:
-  // in a 1-D loop over `region` from its first point (L = c), the value first + L, L read with
-  // ldidx. Returns the symbol bound to L (null if no root reads an iterator).
-  Expr iteratorsFromOffset(ProgramBuilder& b, std::vector<Expr>& roots, const flat::Box& region) {
+  // A template's iterators used as numbers (%k, flat::ElementPatterns::iteratorSymbol) in `roots`,
+  // in the loop over `region` (row-major from its first point): in one dimension first + L, L read
+  // with ldidx (L = c); in more, first_k + X[t_k + c], from a table of each point's subscript k
+  // (minus first_k) read with ldx. Returns the symbols bound per iteration (none if no root reads
+  // an iterator).
+  std::vector<Expr> iteratorsFromOffset(ProgramBuilder& b, std::vector<Expr>& roots, const flat::Box& region) {
     if (!dae_.patterns || std::none_of(roots.begin(), roots.end(), [&](Expr r) { return dae_.patterns->readsIterator(ctx_, r); }))
-      return nullptr;
-    QDOT_ASSERT(region.size() == 1, "an iterator's value in a loop of more than one dimension");
-    Expr offset = ctx_.symbol("$L");
-    b.bindLoopOffset(offset);
-    std::unordered_map<Expr, Expr> map{{dae_.patterns->iteratorSymbol(ctx_, 0), ctx_.add(offset, ctx_.constant(double(region[0].first)))}};
+      return {};
+    std::vector<Expr> perIteration;
+    std::unordered_map<Expr, Expr> map;
+    for (size_t k = 0; k < region.size(); ++k) {
+      Expr value = ctx_.symbol("$X" + std::to_string(k + 1));
+      if (region.size() == 1) {
+        b.bindLoopOffset(value);
+      } else {
+        std::vector<uint32_t> subscripts;
+        subscripts.reserve(flat::pointCount(region));
+        flat::forEachPoint(region, [&](std::span<const long> p, size_t) { subscripts.push_back(static_cast<uint32_t>(p[k] - region[k].first)); });
+        b.bindLoopedLoad(value, Op::LoadTable, b.appendIndexTable(subscripts));
+      }
+      perIteration.push_back(value);
+      map.emplace(dae_.patterns->iteratorSymbol(ctx_, static_cast<int>(k)), ctx_.add(value, ctx_.constant(double(region[k].first))));
+    }
     for (Expr& r : roots) r = ctx_.substitute(r, map);
-    return offset;
+    return perIteration;
   }
 
   // The temporaries whose values read no relative symbol (nor the loop offset), directly or through
   // other temporaries (CSE lists a temporary after those it uses).
-  std::vector<Expr> invariantTemporaries(const sym::CseResult& cse, const std::vector<Operand>& operands, Expr offset = nullptr) {
-    std::unordered_set<Expr> variant;
-    if (offset) variant.insert(offset);
+  std::vector<Expr> invariantTemporaries(const sym::CseResult& cse, const std::vector<Operand>& operands,
+                                         const std::vector<Expr>& perIteration = {}) {
+    std::unordered_set<Expr> variant(perIteration.begin(), perIteration.end());
     for (const auto& op : operands) variant.insert(op.symbol);
     std::vector<Expr> invariant;
     for (const auto& [t, value] : cse.temporaries) {
@@ -651,10 +664,10 @@ class Builder {
     const flat::IndexedTerm& sum = inv.sums[k];
     std::vector<Operand> operands = reader.read(sum.shape, sum.box, sum.body);
     std::vector<Expr> body{sum.body};
-    Expr offset = iteratorsFromOffset(b, body, sum.box);
+    std::vector<Expr> perIteration = iteratorsFromOffset(b, body, sum.box);
     sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, body, "$s" + std::to_string(i) + "_" + std::to_string(k));
     b.setSource(addSource("invariant " + inv.name + ": sum over [" + regionText(sum.box) + "] (one loop)", dae_.range));
-    openLoop(b, cse, operands, offset, sum.shape, sum.box);
+    openLoop(b, cse, operands, perIteration, sum.shape, sum.box);
     b.storeAdd(i, b.lower(cse.outputs[0]));
     b.endLoop();
   }

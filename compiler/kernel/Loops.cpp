@@ -13,7 +13,7 @@ constexpr uint32_t kNone = UINT32_MAX;
 
 bool isLooped(Op op) {
   return op == Op::LoadYLooped || op == Op::LoadYpLooped || op == Op::LoadPLooped || op == Op::LoadLoopOffset ||
-         op == Op::StoreLooped || op == Op::StoreIndexed;
+         op == Op::StoreLooped || op == Op::StoreIndexed || op == Op::LoadTable;
 }
 
 std::string at(size_t i) { return std::string(" at instruction ").append(std::to_string(i)); }
@@ -58,6 +58,10 @@ class LoopChecker {
     if (ins.op == Op::LoadYLooped || ins.op == Op::LoadYpLooped) ok = lo >= 0 && hi < int64_t(variables_);
     if (ins.op == Op::LoadPLooped) ok = lo >= 0 && hi < int64_t(parameters_);
     if (ins.op == Op::StoreLooped) ok = lo >= 0 && hi < int64_t{p_.outputCount};
+    if (ins.op == Op::LoadTable) {
+      uint32_t count = p_.loops[open_].count;
+      ok = ins.imm <= p_.indexTable.size() && p_.indexTable.size() - ins.imm >= count;
+    }
     if (ins.op == Op::StoreIndexed) {
       uint32_t count = p_.loops[open_].count;
       ok = ins.imm <= p_.indexTable.size() && p_.indexTable.size() - ins.imm >= count;

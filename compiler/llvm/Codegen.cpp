@@ -281,6 +281,7 @@ class PartLowering {
       case Op::LoadYpLooped: return b_.CreateLoad(dbl_, loopedPtr(callField(kYp), ins.imm));
       case Op::LoadPLooped: return b_.CreateLoad(dbl_, loopedPtr(callField(kP), ins.imm));
       case Op::LoadLoopOffset: return b_.CreateSIToFP(L_, dbl_);
+      case Op::LoadTable: return b_.CreateUIToFP(tableEntry(ins.imm), dbl_);
       case Op::StoreLooped: b_.CreateStore(A(), loopedPtr(fn_->getArg(kOut), ins.imm)); return nullptr;
       case Op::StoreIndexed: {
         llvm::Value* slot = tableEntry(ins.imm);

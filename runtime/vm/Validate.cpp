@@ -13,7 +13,8 @@ namespace {
 // The opcodes that use the loop state (c, L), allowed only inside a loop body.
 bool isLooped(Opcode op) {
   return op == Opcode::LoadYLooped || op == Opcode::LoadYpLooped || op == Opcode::LoadPLooped ||
-         op == Opcode::LoadLoopOffset || op == Opcode::StoreLooped || op == Opcode::StoreIndexed;
+         op == Opcode::LoadLoopOffset || op == Opcode::StoreLooped || op == Opcode::StoreIndexed ||
+         op == Opcode::LoadTable;
 }
 
 // Which inputs each entry point passes (qdot/programs.def).
@@ -88,7 +89,8 @@ class FunctionChecker {
       case Opcode::LoadConst: return i < f_.constants.size();
       case Opcode::LoadYLooped:
       case Opcode::LoadYpLooped:
-      case Opcode::LoadPLooped: return true;  // with the loop's offsets: loopRules
+      case Opcode::LoadPLooped:
+      case Opcode::LoadTable: return true;  // with the loop's offsets or its count: loopRules
       default: return false;
     }
   }
@@ -122,6 +124,7 @@ class FunctionChecker {
       case Opcode::LoadPLooped: return lo >= 0 && hi < int64_t(d_.parameterCount()) ? "" : "ldpl index out of range";
       case Opcode::StoreLooped: return lo >= 0 && hi < int64_t{f_.outputCount} ? "" : "stl slot out of range";
       case Opcode::StoreIndexed: return indexedSlotsOk(ins.imm) ? "" : "stx index table position or slot out of range";
+      case Opcode::LoadTable: return tableReaches(ins.imm) ? "" : "ldx index table position out of range";
       default: return "";
     }
   }
@@ -146,6 +149,10 @@ class FunctionChecker {
     return "";
   }
 
+  bool tableReaches(uint32_t base) const {
+    uint32_t count = f_.loops[open_].count;
+    return base <= f_.indexTable.size() && f_.indexTable.size() - base >= count;
+  }
   bool indexedSlotsOk(uint32_t base) const {
     uint32_t count = f_.loops[open_].count;
     if (base > f_.indexTable.size() || f_.indexTable.size() - base < count) return false;

@@ -66,7 +66,7 @@ inline uint32_t stepLoop(const ProgramTrace& trace, uint32_t i, LoopPosition& at
 
 // The value `ins` computes (a store: the value stored).
 inline double evaluate(const bc::Instruction& ins, const std::vector<double>& r, const ModelCall& in, const double* k,
-                       const LoopPosition& at) {
+                       const LoopPosition& at, const uint32_t* X) {
   [[maybe_unused]] const uint32_t c = at.c;
   [[maybe_unused]] const int64_t L = at.L;
   [[maybe_unused]] const double t = in.t, cj = in.cj;
@@ -172,7 +172,7 @@ inline std::string diagnoseNonFinite(const ModelDescription& d, std::span<const 
       if (origin[deps[j]] == kConstantOrigin) undefined = true;
       else if (from == kFiniteOrigin) from = origin[deps[j]];
     }
-    double value = evaluate(ins, r, in, trace.constants.data(), at);
+    double value = evaluate(ins, r, in, trace.constants.data(), at, trace.indexTable.data());
     if (ins.op == bc::Opcode::LoadConst) {
       r[ins.dest] = value, origin[ins.dest] = std::isfinite(value) ? kFiniteOrigin : kConstantOrigin;
       continue;

@@ -201,5 +201,17 @@ TEST_F(LoopLowering, CheckLoopsBoundsALoopedParameterLoad) {
   EXPECT_NE(kernel::checkLoops(outside, 4, 5).find("ldpl outside a loop"), std::string::npos);
 }
 
+// A table entry read as a number (ldx X[imm + c]) must lie in the index table for every iteration.
+TEST_F(LoopLowering, CheckLoopsBoundsATableEntryReadAsANumber) {
+  kernel::Program p = doubledInLoop(Op::LoadTable, 1, 3, 0);  // X[1 + c], c = 0..2
+  p.indexTable = {9, 4, 5, 6};
+  EXPECT_EQ(kernel::checkLoops(p, 4, 0), "");
+  std::vector<double> out(4, -1.0);
+  kernel::interpret(p, {}, out);
+  EXPECT_EQ(out, (std::vector<double>{8.0, 10.0, 12.0, -1.0}));
+  p.indexTable.pop_back();  // X[3] missing
+  EXPECT_NE(kernel::checkLoops(p, 4, 0).find("ldx index out of range"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace qdot::test

@@ -3,7 +3,7 @@
 // values from before a loop cross parts) give the same bits as the direct C++ computation — an
 // affine stencil with peeled ends and invariant registers, count 0 and 1, a table loop storing
 // through a permutation (stx) with ldidx, negative strides, a value from before a loop used after
-// it, a parameter array read with ldpl, a sum over a loop (stadd). A NaN inside a loop is named with its iteration on the VM
+// it, a parameter array read with ldpl, a sum over a loop (stadd), table entries as numbers (ldx). A NaN inside a loop is named with its iteration on the VM
 // and on the JIT.
 #include <cstdio>
 #include <functional>
@@ -155,6 +155,24 @@ TEST(Loops, TableLoopAndIndexedStoresOnEveryBackend) {
   expectEveryBackend(w.p, n, [&](const double* y, const double*, double kv, double* F) {
     for (uint32_t c = 0; c + 1 < n; ++c) F[slots[c]] = 2.0 * y[offsets[c]] + double(offsets[c]);
     F[n - 1] = kv + 1.0;
+  });
+}
+
+// A table entry as a number (ldx, a template's iterator value in a table loop): out[L] = y[L]·(W[c] + 0.5)
+// for L = X[c], W a second table read at the same iteration.
+TEST(Loops, TableEntriesAsNumbersOnEveryBackend) {
+  const uint32_t n = 6;
+  std::vector<uint32_t> offsets = {3, 0, 5, 1, 4, 2}, weights = {7, 1, 0, 4, 2, 9};
+  Writer w;
+  w.p.indexTable = offsets;
+  w.p.indexTable.insert(w.p.indexTable.end(), weights.begin(), weights.end());
+  uint32_t half = w.k(0.5);
+  w.loop(Loop{.count = n, .offsetTable = 0});
+  uint32_t weight = w.op(Op::Add, w.op(Op::LoadTable, 0, 0, 0, n), half);
+  w.op(Op::StoreLooped, w.op(Op::Mul, w.op(Op::LoadYLooped), weight), 0, 0, 0);
+  w.endLoop();
+  expectEveryBackend(w.p, n, [&](const double* y, const double*, double, double* F) {
+    for (uint32_t c = 0; c < n; ++c) F[offsets[c]] = y[offsets[c]] * (double(weights[c]) + 0.5);
   });
 }
 

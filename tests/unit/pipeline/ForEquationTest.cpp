@@ -232,9 +232,9 @@ end EquationChain;
 using test::expectScalarFallback;
 
 // A heat source whose strength depends on the node, q0·exp(−((i − c)/w)²): the iterator's value in
-// a 1-D loop (from its offset); in a plate (two iterators) the model is compiled as without
-// templates.
-TEST(ForEquations, IteratorsAsNumbersAreOneLoopInOneDimension) {
+// a 1-D loop (from its offset); in a plate (two iterators) from a table of each point's subscripts
+// (ldx).
+TEST(ForEquations, IteratorsAsNumbersAreOneLoop) {
   std::string rod = R"(model HeatedRod
   parameter Integer n = 9;
   parameter Real a = 1.7, q0 = 3, w = 2;
@@ -248,8 +248,10 @@ equation
 end HeatedRod;
 )";
   EXPECT_EQ(expectSameKernels(rod, 1), 1u);
-  std::string p = plate("  for i in 2:n-1, j in 2:m-1 loop\n    der(T[i, j]) = a*(T[i+1, j] + T[i-1, j] + T[i, j+1] + T[i, j-1] - 4*T[i, j]) + 0.01*i*j;\n  end for;");
-  expectScalarFallback(p);
+  std::string p = plate("  for i in 2:n-1, j in 2:m-1 loop\n    der(T[i, j]) = a*(T[i+1, j] + T[i-1, j] + T[i, j+1] + T[i, j-1] - 4*T[i, j]) + 0.01*i*j^2;\n  end for;");
+  EXPECT_EQ(expectSameKernels(p, 1), 1u);
+  Compiled looped(p, true);
+  EXPECT_GT(test::opCount(looped.kernels().program(ModelProgram::Residual), kernel::Op::LoadTable), 0u);
 }
 
 // Initial equations that give states their start values (`T[1] = …`, also in a loop) keep the

@@ -175,6 +175,27 @@ mechanics
 end Graded;
 )";
 
+// The same in two dimensions: a grid whose masses and springs vary with both subscripts, read from
+// tables of each point's subscripts (ldx) in the loops of the rows, the Jacobian and the Jacobi
+// integral.
+TEST(LoopedKernels, IteratorsAsNumbersInTwoDimensionsGiveTheScalarKernels) {
+  const char* grid = R"(model GradedGrid
+  parameter Integer n = 6, m = 5;
+  parameter Real k = 10;
+  coordinate Real z[n, m](start = {{0.01*i*j for j in 1:m} for i in 1:n});
+mechanics
+  kinetic = sum(0.5*(1 + 0.1*i + 0.01*j^2)*der(z[i, j])^2 for i in 1:n, j in 1:m);
+  potential = sum(0.5*k*(1 + 0.05*i*j)*(z[i+1, j] - z[i, j])^2 for i in 1:n-1, j in 1:m)
+            + sum(0.5*k*(z[i, j+1] - z[i, j])^2 + 0.1*k*sin(i - j)*z[i, j]^4 for i in 1:n, j in 1:m-1);
+end GradedGrid;
+)";
+  EXPECT_GE(expectSameKernels(grid), 2u);
+  expectSameInvariants(grid, 3);
+  Compiled looped(grid, true);
+  EXPECT_GT(test::opCount(looped.kernels().program(ModelProgram::Residual), kernel::Op::LoadTable), 0u);
+  EXPECT_GT(test::opCount(looped.kernels().program(ModelProgram::Invariants), kernel::Op::LoadTable), 0u);
+}
+
 TEST(LoopedKernels, IteratorsAsNumbersGiveTheScalarResidualJacobianAndInvariants) {
   EXPECT_EQ(expectSameKernels(kGradedChain), 2u);
   expectSameInvariants(kGradedChain, 2);
