@@ -341,6 +341,26 @@ TEST(VmLoopValidation, RejectsALoopedParameterLoadOutsideTheParameters) {
   EXPECT_NE(s.error().find("ldpl"), std::string::npos) << s.error();
 }
 
+// ldx reads X[imm + c] as a number; the validator wants that entry in the table at every iteration.
+TEST(VmLoopValidation, ATableEntryReadAsANumberStaysInTheTable) {
+  const uint32_t n = 5;
+  bc::Module m = parameterLoop(n);
+  bc::Function& f = m.function(ModelProgram::Residual);
+  f.code[wordOf(f, Opcode::LoadPLooped)] = uint32_t(Opcode::LoadTable);  // X[1 + c] instead of a[1 + L]
+  f.indexTable = {0, 10, 20, 30, 40};
+  ASSERT_TRUE(bc::validate(m)) << bc::validate(m).error();
+  Result<ModelPtr> model = vm::createModel(m);
+  ASSERT_TRUE(model.ok()) << model.error();
+  QdotModel* q = model.value().get();
+  std::vector<double> y = randomY(n), yp(n, 0.0), p(n, 1.0), F(n, -99.0);
+  EXPECT_EQ(q->residual(q, 0, y.data(), yp.data(), p.data(), F.data()), 0);
+  for (uint32_t c = 0; c + 1 < n; ++c) EXPECT_EQ(F[c], 10.0 * (c + 1) * y[c]) << c;
+  f.indexTable.pop_back();  // X[4] missing at c = 3
+  Status s = bc::validate(m);
+  ASSERT_FALSE(s);
+  EXPECT_NE(s.error().find("ldx index table position out of range"), std::string::npos) << s.error();
+}
+
 TEST(VmLoops, ANonFiniteValueInsideALoopNamesItsIterationAndOffset) {
   bc::Module m = stencil(8);
   Result<ModelPtr> model = vm::createModel(m);
