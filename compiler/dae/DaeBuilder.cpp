@@ -32,6 +32,7 @@ class Builder {
     if (!m_.equationTemplates.empty()) {  // an explicit ODE (isTemplatedOde): balanced by construction
       addParameters();
       addTemplatedOde(m_, ctx_, dae_);
+      expandOutputSums();
       return std::move(dae_);
     }
     collectAliases();
@@ -46,7 +47,7 @@ class Builder {
                                  substituted(fi.value), fi.sums});
     if (!aliases_.empty()) substituteRest();
     if (!eom_.templateRows.empty()) addTemplateBlocks(), addScalarKinematicResiduals();
-    if (!dae_.templated()) expandInvariantSums();
+    if (!dae_.templated()) expandInvariantSums(), expandOutputSums();
     // Template rows are one Euler–Lagrange row per coordinate and its kinematic row by construction.
     if (diags_.errorCount() == errorsBefore && !dae_.templated()) checkBalance(dae_, ctx_, diags_);
     if (diags_.errorCount() > errorsBefore) return std::nullopt;
@@ -63,6 +64,14 @@ class Builder {
         flat::forEachPoint(sum.box, [&](std::span<const long> p, size_t) { terms.push_back(flat::instantiate(m_, ctx_, sum.body, p)); });
       inv.value = ctx_.add(terms);
       inv.sums.clear();
+    }
+  }
+  // An output's sums likewise (flat::withSumsExpanded: what the scalar lowering of its binding gives).
+  void expandOutputSums() {
+    for (flat::Output& o : dae_.outputs) {
+      if (o.sums.empty()) continue;
+      o.value = substituted(flat::withSumsExpanded(m_, ctx_, o.value, o.sums));
+      o.sums.clear();
     }
   }
 
@@ -109,7 +118,10 @@ class Builder {
   bool appears(Expr s) const { return s->symbolId < appears_.size() && appears_[s->symbolId]; }
 
   void substituteRest() {
-    for (auto& o : dae_.outputs) o.value = substituted(o.value);
+    for (auto& o : dae_.outputs) {
+      o.value = substituted(o.value);
+      for (flat::IndexedTerm& sum : o.sums) sum.body = substituted(sum.body);
+    }
     for (auto& v : dae_.variables) v.declaration.start = substituted(v.declaration.start);
   }
 

@@ -60,7 +60,11 @@ void printDae(std::ostream& os, const Dae& dae, const sym::Context& ctx, const S
   for (const Parameter& p : dae.parameters)
     os << "  " << p.name << " = " << sym::toString(ctx, p.value) << at(sm, p.declRange) << "\n";
   os << "\noutputs (" << dae.outputs.size() << "):\n";
-  for (const auto& o : dae.outputs) os << "  " << o.name << " = " << sym::toString(ctx, o.value) << at(sm, o.range) << "\n";
+  for (const auto& o : dae.outputs) {
+    os << "  " << o.name << " = " << sym::toString(ctx, o.value);
+    for (const flat::IndexedTerm& sum : o.sums) os << " + " << flat::sumText(sum, ctx);
+    os << at(sm, o.range) << "\n";
+  }
   os << "\ninvariants (" << dae.invariants.size() << "):\n";
   for (const Invariant& inv : dae.invariants)
     os << "  " << inv.name << " (" << inv.kind << ") = " << sym::toString(ctx, inv.value) << "\n";

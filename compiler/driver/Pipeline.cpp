@@ -70,7 +70,7 @@ bool check(Compilation& c) {
 // coordinates or velocities, or an array of parameters a loop addresses as p[first + linear index]
 // (flat::loopableParameters; in several dimensions of the shape of the coordinates the template
 // reads). `shape`: the coordinates' shape if known (a force's target), else null.
-bool loopsRead(const flat::FlatModel& m, sym::Expr body, size_t rank, const std::vector<int>* shape,
+bool loopsRead(const flat::FlatModel& m, sym::Expr body, size_t rank, const std::vector<int>*& shape,
                const sym::Context& ctx) {
   std::vector<const flat::RelativeElement*> parameters;
   for (sym::Expr s : ctx.freeSymbols(body)) {
@@ -92,8 +92,24 @@ bool loopsRead(const flat::FlatModel& m, sym::Expr body, size_t rank, const std:
 }
 
 bool loopsReadForce(const flat::FlatModel& m, const flat::IndexedForce& f, const sym::Context& ctx) {
-  const flat::ArrayVariable& target = m.patterns->arrays[m.relativeElement(f.target)->array];
-  return loopsRead(m, f.body, f.box.size(), &target.shape, ctx);
+  const std::vector<int>* shape = &m.patterns->arrays[m.relativeElement(f.target)->array].shape;
+  return loopsRead(m, f.body, f.box.size(), shape, ctx);
+}
+
+// A templated model's outputs: each sum a loop reads (over coordinates or velocities, see
+// loopsRead) takes their shape and stays a loop; the others (over parameters or the iterator only)
+// are expanded into the output's value.
+void shapeOutputSums(flat::FlatModel& m, sym::Context& ctx) {
+  for (flat::Output& o : m.outputs) {
+    std::vector<flat::IndexedTerm> expanded;
+    std::erase_if(o.sums, [&](flat::IndexedTerm& sum) {
+      const std::vector<int>* shape = nullptr;
+      if (loopsRead(m, sum.body, sum.box.size(), shape, ctx) && shape) return sum.shape = *shape, false;
+      expanded.push_back(std::move(sum));
+      return true;
+    });
+    o.value = flat::withSumsExpanded(m, ctx, o.value, expanded);
+  }
 }
 
 // Where the stages after flattening take templates (docs/loops.md): a model of energies over
@@ -117,7 +133,10 @@ bool templatesApply(const flat::FlatModel& m, const CompileOptions& o, const sym
   }
   return plain &&
          std::all_of(m.indexedSums.begin(), m.indexedSums.end(),
-                     [&](const flat::IndexedSum& sum) { return loopsRead(m, sum.body, sum.box.size(), nullptr, ctx); }) &&
+                     [&](const flat::IndexedSum& sum) {
+                       const std::vector<int>* shape = nullptr;
+                       return loopsRead(m, sum.body, sum.box.size(), shape, ctx);
+                     }) &&
          std::all_of(m.indexedForces.begin(), m.indexedForces.end(),
                      [&](const flat::IndexedForce& f) { return loopsReadForce(m, f, ctx); });
 }
@@ -183,6 +202,9 @@ bool readsIterators(const flat::FlatModel& m, const sym::Context& ctx) {
     if (m.patterns->readsIterator(ctx, sum.body)) return true;
   for (const auto& f : m.indexedForces)
     if (m.patterns->readsIterator(ctx, f.body)) return true;
+  for (const auto& o : m.outputs)
+    for (const auto& sum : o.sums)
+      if (m.patterns->readsIterator(ctx, sum.body)) return true;
   return false;
 }
 
@@ -239,6 +261,7 @@ bool flatten(Compilation& c) {
       defineAsOutputs(*model, *defined);
       c.eliminated.eliminated = defined->size();  // solved out as the scalar DAE would have them
     }
+    if (templates) shapeOutputSums(*model, c.ctx);
     if (model && !templates) {
       if (!readsIterators(*model, c.ctx) || c.diags.hasErrors()) {
         flat::expandIndexedSums(*model, c.ctx);  // exactly the scalar lowering's nodes

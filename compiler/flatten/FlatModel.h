@@ -96,18 +96,6 @@ struct Term {
   bool connectionFlow = false;  ///< a force: a connector's flow (spec §7), not a `force(q)` statement
 };
 
-/// How the runtime treats an output column between rows (`annotation(unwrap = …)`): an angle made
-/// continuous by multiples of 2π, or one of a z-x-z Euler-angle triple ψ, θ, φ (a rigid body's),
-/// made continuous together (θ changes sign where the body passes through θ = 0).
-enum class OutputKind : uint8_t { Plain, Angle, EulerPsi, EulerTheta, EulerPhi };
-
-struct Output {
-  std::string name;
-  sym::Expr value = nullptr;
-  SourceRange range;
-  OutputKind kind = OutputKind::Plain;
-};
-
 /// A box of subscripts or iterator values (issue 15): per dimension its first and last value,
 /// inclusive. Every template ranges over one; these are the only walks over them.
 using Box = std::vector<std::pair<long, long>>;
@@ -245,6 +233,23 @@ struct EquationTemplate {
   Box box;  ///< per iterator (nested loops: outer first): first and last value
   sym::Expr lhs = nullptr, rhs = nullptr;
   Origin origin;  ///< the equation inside the loop (no element)
+};
+
+/// How the runtime treats an output column between rows (`annotation(unwrap = …)`): an angle made
+/// continuous by multiples of 2π, or one of a z-x-z Euler-angle triple ψ, θ, φ (a rigid body's),
+/// made continuous together (θ changes sign where the body passes through θ = 0).
+enum class OutputKind : uint8_t { Plain, Angle, EulerPsi, EulerTheta, EulerPhi };
+
+/// An output column: `value`, plus with templates (FlattenLimits::keepLoops) the sums over boxes
+/// that its binding's `sum(... for i in a:b)` summands are kept as: the output is value + Σ sums.
+/// The flattener records them with an empty shape; the pipeline gives each the shape of the
+/// coordinates it reads where a loop can compute it and expands the others (expandOutputSums).
+struct Output {
+  std::string name;
+  sym::Expr value = nullptr;
+  SourceRange range;
+  OutputKind kind = OutputKind::Plain;
+  std::vector<IndexedTerm> sums;
 };
 
 struct Experiment {

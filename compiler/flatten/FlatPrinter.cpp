@@ -65,6 +65,13 @@ void printExperiment(std::ostream& os, const Experiment& e) {
   os << (any ? "\n" : " (none)\n");
 }
 
+std::string sumText(const IndexedTerm& sum, const sym::Context& ctx) {
+  std::string box;
+  for (size_t d = 0; d < sum.box.size(); ++d)
+    box += (d ? ", %" : "%") + std::to_string(d + 1) + " in " + std::to_string(sum.box[d].first) + ":" + std::to_string(sum.box[d].second);
+  return "sum(" + sym::toString(ctx, sum.body) + " for " + box + ")";
+}
+
 const char* originKindName(OriginKind k) {
   switch (k) {
     case OriginKind::Equation: return "equation";
@@ -94,7 +101,11 @@ void printFlatModel(std::ostream& os, const FlatModel& m, const sym::Context& ct
   printEquations(os, "initial equations", m.initialEquations, ctx, sm);
   printEquations(os, "constraints", m.constraints, ctx, sm);
   os << "outputs (" << m.outputs.size() << "):\n";
-  for (const Output& o : m.outputs) os << "  " << o.name << " = " << sym::toString(ctx, o.value) << at(sm, o.range) << "\n";
+  for (const Output& o : m.outputs) {
+    os << "  " << o.name << " = " << sym::toString(ctx, o.value);
+    for (const IndexedTerm& sum : o.sums) os << " + " << sumText(sum, ctx);
+    os << at(sm, o.range) << "\n";
+  }
   os << "\n";
   printExperiment(os, m.experiment);
 }

@@ -22,6 +22,9 @@ std::string lineOf(const SourceManager& sm, SourceRange r);
 /// "experiment: StopTime = 10, Interval = 0.01" (the annotation's values, shortest round-trip form).
 void printExperiment(std::ostream& os, const Experiment& e);
 
+/// "sum(body for %1 in 1:9)": a sum kept as a template (an output's), its iterators as %1, %2, ….
+std::string sumText(const IndexedTerm& sum, const sym::Context& ctx);
+
 /// The kind of an equation's origin in words: "equation", "Euler-Lagrange row", "constraint" ...
 const char* originKindName(OriginKind k);
 

@@ -138,9 +138,13 @@ std::optional<FlatModel> Flattener::run() {
 
 void Flattener::declareInstance(Instance& inst) {
   cur_ = &inst;
-  for (const auto* d : inst.cls->declarations)
-    if (inst.cls->symbols.at(d->name).kind != sema::SymbolKind::Component)
-      guarded([&] { valueOf(inst, inst.cls->symbols.at(d->name), d->nameRange); });
+  for (const auto* d : inst.cls->declarations) {
+    const sema::ModelSymbol& s = inst.cls->symbols.at(d->name);
+    if (s.kind != sema::SymbolKind::Component)
+      guarded([&] {
+        if (!limits_.keepLoops || !lowerOutputKeepingSums(inst, s)) valueOf(inst, s, d->nameRange);
+      });
+  }
 }
 
 void Flattener::lowerInstance(Instance& inst) {
@@ -345,6 +349,11 @@ Value Flattener::createDeclaration(const Declaration& d, const sema::ModelSymbol
       if (d.causality == Causality::Output) {
         std::vector<std::string> names = scalarNames(name, shape);
         OutputKind kind = outputKind(d);
+        if (auto kept = keptOutputs_.find(&cur_->slots[s.index]); kept != keptOutputs_.end()) {
+          out_.outputs[kept->second].value = v.elems[0];  // used elsewhere as well: expanded after all
+          out_.outputs[kept->second].sums.clear();
+          return v;
+        }
         for (size_t i = 0; i < v.size(); ++i) out_.outputs.push_back({names[i], v.elems[i], d.nameRange, kind});
       }
       return v;

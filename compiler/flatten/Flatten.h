@@ -49,8 +49,13 @@ std::optional<FlatModel> flatten(const sema::CheckedModel& model, sym::Context& 
 /// values, relative symbols the elements they stand for. `point` has one value per iterator.
 sym::Expr instantiate(const FlatModel& model, sym::Context& ctx, sym::Expr body, std::span<const long> point);
 
-/// Expands every IndexedSum into its energy term and every IndexedForce into its forces (the model
-/// then is what flattening without keepLoops gives) and clears the templates.
+/// value + Σ over each sum's box of its body at that point (the sums in order, each one Add of its
+/// points): what the scalar lowering gives for a binding `value + sum(…) + …`.
+sym::Expr withSumsExpanded(const FlatModel& model, sym::Context& ctx, sym::Expr value, const std::vector<IndexedTerm>& sums);
+
+/// Expands every IndexedSum into its energy term, every IndexedForce into its forces and every
+/// output's sums into its value (the model then is what flattening without keepLoops gives) and
+/// clears the templates.
 void expandIndexedSums(FlatModel& model, sym::Context& ctx);
 
 /// Whether a loop can read relative symbol `rel` of a template over `rank` iterators, whose rows are

@@ -292,6 +292,10 @@ class Flattener {
   // IndexedSums.cpp (FlattenLimits::keepLoops)
   void addTermsKeepingLoops(std::vector<Term>& into, const ast::MechanicsStmt& st, const char* what);
   bool lowerIndexedSum(const ast::CallExpr& call, bool negated, IndexedSum& sum);
+  bool lowerOutputKeepingSums(Instance& inst, const sema::ModelSymbol& s);
+  /// The outputs lowered with their sums kept (lowerOutputKeepingSums), by declaration: a later use
+  /// of the definition resolves it as usual, and its output then takes the expanded value.
+  std::map<const Instance::Slot*, size_t> keptOutputs_;
   std::optional<Value> lowerRelativeIndex(const ast::IndexExpr& e);
   sym::Expr relativeSymbol(const RelativeElement& rel);
   int arrayOf(const Value& declared, const std::string& name);

@@ -183,6 +183,46 @@ void Flattener::addTermsKeepingLoops(std::vector<Term>& into, const MechanicsStm
   into.push_back({ctx_.add(scalars), st.range});
 }
 
+// A scalar `output Real y = …` of the model whose binding has `sum(… for i in a:b)` summands:
+// the output with the sums a loop can compute kept as templates (Output::sums), its value the other
+// summands; false (nothing lowered) where the declaration is lowered as usual — not the model's
+// own, not a scalar output definition, modified, or no sum kept. The declaration itself stays
+// unresolved: a use of it elsewhere resolves it as usual (keptOutputs_ then expands the output).
+bool Flattener::lowerOutputKeepingSums(Instance& inst, const sema::ModelSymbol& s) {
+  const ast::Declaration& d = *s.decl;
+  Instance::Slot& slot = inst.slots[s.index];
+  if (&inst != &instances_.front() || s.kind != sema::SymbolKind::Definition || d.causality != Causality::Output ||
+      !d.binding || !d.typeDims.empty() || !d.dims.empty() || slot.state != Instance::Slot::Empty ||
+      modifierOf(inst, d))
+    return false;
+  std::vector<Summand> summands;
+  collectSummands(*d.binding, false, summands);
+  auto isSum = [&](const Summand& t) { const CallExpr* c = sumCall(*t.expr); return c && !m_.calls.count(c); };
+  if (std::none_of(summands.begin(), summands.end(), isSum)) return false;
+  slot.state = Instance::Slot::Pending;  // a binding that reads its own output is a cycle (E0312)
+  std::vector<Expr> scalars;
+  std::vector<IndexedTerm> sums;
+  try {
+    for (const Summand& t : summands) {
+      IndexedSum sum;
+      if (isSum(t) && lowerIndexedSum(*sumCall(*t.expr), t.negated, sum)) {
+        sums.push_back({std::move(sum.box), {}, sum.body});
+        continue;
+      }
+      Expr v = lowerScalar(*t.expr, "an output");
+      scalars.push_back(t.negated ? ctx_.neg(v) : v);
+    }
+  } catch (...) {
+    slot.state = Instance::Slot::Failed;
+    throw;
+  }
+  slot.state = Instance::Slot::Empty;
+  if (sums.empty()) return false;  // lowered as usual (again: its side effects are made already, in the same order)
+  keptOutputs_[&slot] = out_.outputs.size();
+  out_.outputs.push_back({d.name, ctx_.add(scalars), d.nameRange, outputKind(d), std::move(sums)});
+  return true;
+}
+
 // Appends a loop's iterator `a:b` to `its` if it can be a template's: plain integer bounds that
 // name no earlier iterator, a range that is not empty, a name not taken by an earlier iterator.
 bool Flattener::addTemplateIterator(const ast::Iterator& it, std::vector<TemplateIterator>& its) {
@@ -553,7 +593,21 @@ bool loopableParameters(const FlatModel& m, const RelativeElement& rel, size_t r
   return true;
 }
 
+Expr withSumsExpanded(const FlatModel& model, sym::Context& ctx, Expr value, const std::vector<IndexedTerm>& sums) {
+  for (const IndexedTerm& sum : sums) {
+    std::vector<Expr> parts;
+    parts.reserve(pointCount(sum.box));
+    forEachPoint(sum.box, [&](std::span<const long> point, size_t) { parts.push_back(instantiate(model, ctx, sum.body, point)); });
+    value = ctx.add(value, ctx.add(parts));
+  }
+  return value;
+}
+
 void expandIndexedSums(FlatModel& model, sym::Context& ctx) {
+  for (Output& o : model.outputs) {
+    o.value = withSumsExpanded(model, ctx, o.value, o.sums);
+    o.sums.clear();
+  }
   for (const IndexedSum& sum : model.indexedSums) {
     std::vector<Expr> parts;
     parts.reserve(pointCount(sum.box));

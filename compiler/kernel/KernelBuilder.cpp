@@ -639,7 +639,13 @@ class Builder {
       values.push_back(o.value);
       sources.push_back(addSource("output " + o.name, o.range, o.name + " = " + sym::toString(ctx_, o.value)));
     }
-    return buildMonitor(ModelProgram::Outputs, values, sources);
+    return buildMonitor(ModelProgram::Outputs, values, sources, [&](ProgramBuilder& b) {
+      LoopOperands operands(dae_, ctx_, unknowns());
+      for (uint32_t i = 0; i < dae_.outputs.size(); ++i)
+        for (size_t k = 0; k < dae_.outputs[i].sums.size(); ++k)
+          emitSum(b, i, dae_.outputs[i].sums[k], "output " + dae_.outputs[i].name, "$o" + std::to_string(i) + "_" + std::to_string(k),
+                  dae_.outputs[i].range, operands);
+    });
   }
 
   Program buildInvariants() {
@@ -652,21 +658,22 @@ class Builder {
     return buildMonitor(ModelProgram::Invariants, values, sources, [&](ProgramBuilder& b) {
       LoopOperands operands(dae_, ctx_, unknowns());
       for (uint32_t i = 0; i < dae_.invariants.size(); ++i)
-        for (size_t k = 0; k < dae_.invariants[i].sums.size(); ++k) emitSum(b, i, k, operands);
+        for (size_t k = 0; k < dae_.invariants[i].sums.size(); ++k)
+          emitSum(b, i, dae_.invariants[i].sums[k], "invariant " + dae_.invariants[i].name,
+                  "$s" + std::to_string(i) + "_" + std::to_string(k), dae_.range, operands);
     });
   }
 
-  // Invariant i's k-th sum: one loop adding its body at every point of its box to out[i] (after
-  // the invariant's scalar part was stored there), with the body's own CSE and its loop-invariant
-  // temporaries computed before the loop.
-  void emitSum(ProgramBuilder& b, uint32_t i, size_t k, LoopOperands& reader) {
-    const dae::Invariant& inv = dae_.invariants[i];
-    const flat::IndexedTerm& sum = inv.sums[k];
+  // A sum of monitored quantity i (an invariant's, an output's): one loop adding its body at every
+  // point of its box to out[i] (after the quantity's scalar part was stored there), with the body's
+  // own CSE (temporaries named `prefix`…) and its loop-invariant temporaries computed before the loop.
+  void emitSum(ProgramBuilder& b, uint32_t i, const flat::IndexedTerm& sum, const std::string& what, const std::string& prefix,
+               SourceRange range, LoopOperands& reader) {
     std::vector<Operand> operands = reader.read(sum.shape, sum.box, sum.body);
     std::vector<Expr> body{sum.body};
     std::vector<Expr> perIteration = iteratorsFromOffset(b, body, sum.box);
-    sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, body, "$s" + std::to_string(i) + "_" + std::to_string(k));
-    b.setSource(addSource("invariant " + inv.name + ": sum over [" + regionText(sum.box) + "] (one loop)", dae_.range));
+    sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, body, prefix);
+    b.setSource(addSource(what + ": sum over [" + regionText(sum.box) + "] (one loop)", range));
     openLoop(b, cse, operands, perIteration, sum.shape, sum.box);
     b.storeAdd(i, b.lower(cse.outputs[0]));
     b.endLoop();

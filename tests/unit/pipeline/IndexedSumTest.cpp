@@ -282,6 +282,80 @@ std::vector<mech::TemplateRow> expectRowsMatchScalarDerivation(const char* name,
   return t.rows;
 }
 
+// An output defined by sums (`output Real E = sum(…) + …`): its sums are kept as templates
+// (Output::sums) and its value holds the other summands; expanded, it is the scalar lowering's
+// value node for node. The output read by another definition is expanded where that one is made.
+constexpr const char* kChainWithEnergyOutputs = R"(model Chain
+  parameter Integer n = 6;
+  parameter Real m = 1, k = 1000, c = 0.5;
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+  output Real E = sum(0.5*m*der(x[i])^2 for i in 1:n) + 0.5*k*x[1]^2 + sum(0.5*k*(x[i+1] - x[i])^2 for i in 1:n-1);
+  output Real P = -sum(c*(der(x[i+1]) - der(x[i]))^2 for i in 1:n-1) - c*der(x[1])^2;
+mechanics
+  kinetic = sum(0.5*m*der(x[i])^2 for i in 1:n);
+  potential = 0.5*k*x[1]^2 + sum(0.5*k*(x[i+1] - x[i])^2 for i in 1:n-1);
+end Chain;
+)";
+
+void expectSameOutputs(const flat::FlatModel& scalar, const flat::FlatModel& expanded) {
+  ASSERT_EQ(scalar.outputs.size(), expanded.outputs.size());
+  for (size_t o = 0; o < scalar.outputs.size(); ++o) {
+    EXPECT_EQ(scalar.outputs[o].name, expanded.outputs[o].name);
+    EXPECT_EQ(scalar.outputs[o].value, expanded.outputs[o].value) << scalar.outputs[o].name;
+    EXPECT_TRUE(expanded.outputs[o].sums.empty());
+  }
+}
+
+TEST(IndexedSum, OutputSumsStayTemplatesAndExpandToTheScalarValue) {
+  test::SourceDae s("outputs.qd", kChainWithEnergyOutputs, driver::Stage::Check);
+  Flattened f = flattenBoth(s);
+  ASSERT_TRUE(f.scalar && f.templated);
+  ASSERT_EQ(f.templated->outputs.size(), 2u);
+  const flat::Output& E = f.templated->outputs[0];
+  EXPECT_EQ(E.name, "E");
+  ASSERT_EQ(E.sums.size(), 2u);
+  EXPECT_EQ(E.sums[0].box, (flat::Box{{1, 6}}));
+  EXPECT_EQ(E.sums[1].box, (flat::Box{{1, 5}}));
+  EXPECT_TRUE(E.sums[0].shape.empty());  // the pipeline gives it (shapeOutputSums)
+  EXPECT_EQ(sym::toString(s.ctx, E.value), "0.5*k*x[1]^2");
+  EXPECT_EQ(f.templated->outputs[1].sums.size(), 1u);
+  flat::expandIndexedSums(*f.templated, s.ctx);
+  expectSameOutputs(*f.scalar, *f.templated);
+}
+
+TEST(IndexedSum, AnOutputReadElsewhereIsExpandedAsTheScalarLoweringDoes) {
+  for (const char* other : {"  output Real twice = 2*E;\n", "  Real half = E/2;\n  output Real h = half;\n"}) {
+    std::string text = kChainWithEnergyOutputs;
+    std::string before = text, after = text;
+    size_t e = text.find("  output Real E"), p = text.find("  output Real P");
+    after.insert(p, other);    // declared after E: E is kept first, then expanded by the use
+    before.insert(e, other);   // declared before E: resolved through the use first
+    for (const std::string& t : {after, before}) {
+      test::SourceDae s("used.qd", t, driver::Stage::Check);
+      Flattened f = flattenBoth(s);
+      ASSERT_TRUE(f.scalar && f.templated);
+      size_t at = 0;
+      while (at < f.templated->outputs.size() && f.templated->outputs[at].name != "E") ++at;
+      ASSERT_LT(at, f.templated->outputs.size());
+      EXPECT_TRUE(f.templated->outputs[at].sums.empty()) << other;
+      flat::expandIndexedSums(*f.templated, s.ctx);
+      expectSameOutputs(*f.scalar, *f.templated);
+    }
+  }
+}
+
+TEST(IndexedSum, AnOutputSumReadingItselfIsTheUsualCycleError) {
+  std::string text = kChainWithEnergyOutputs;
+  text.replace(text.find("- c*der(x[1])^2;"), 16, "- c*der(x[1])^2 + P;");
+  test::SourceDae s("cycle.qd", text, driver::Stage::Check);
+  flat::FlattenLimits keep;
+  keep.keepLoops = true;
+  EXPECT_FALSE(flat::flatten(*s.compilation.checked, s.ctx, s.diags, keep));
+  std::ostringstream rendered;
+  s.diags.render(rendered, s.sources);
+  EXPECT_NE(rendered.str().find("error[E0312]: the definition of 'P' depends on itself"), std::string::npos) << rendered.str();
+}
+
 TEST(TemplateRows, ChainInteriorIsOneTemplateAndEqualsTheScalarRows) {
   std::string chain = kChain;
   auto rows = expectRowsMatchScalarDerivation("chain.qd", chain.c_str());

@@ -255,6 +255,45 @@ TEST(LoopedKernels, ExplicitDefinitionsBecomeOutputsAndKeepTheLoops) {
   EXPECT_FALSE(stays.c.dae->templated());
 }
 
+// Outputs defined by sums (the chain's energy and dissipated power): each sum one loop adding to
+// its output (stadd), the values those of the scalar outputs; an output over parameters only is
+// expanded (no coordinates to give its loop a shape).
+TEST(LoopedKernels, OutputSumsAreLoopsWithTheScalarValues) {
+  const std::string text = R"(model Chain
+  parameter Integer n = 7;
+  parameter Real m = 1, k = 1000, c = 0.5, w[n] = {1 + 0.1*i for i in 1:n};
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+  output Real E = sum(0.5*m*der(x[i])^2 for i in 1:n) + 0.5*k*x[1]^2 + sum(0.5*k*(x[i+1] - x[i])^2 for i in 1:n-1);
+  output Real P = -sum(c*(der(x[i+1]) - der(x[i]))^2 for i in 1:n-1) - c*der(x[1])^2;
+  output Real centre = sum(w[i]*x[i] for i in 1:n)/sum(w[i] for i in 1:n);
+  output Real ramp = sum(0.1*i*x[i] for i in 2:n);
+  output Real weights = sum(w[i] for i in 1:n) + 1;
+mechanics
+  kinetic = sum(0.5*m*der(x[i])^2 for i in 1:n);
+  potential = 0.5*k*x[1]^2 + sum(0.5*k*(x[i+1] - x[i])^2 for i in 1:n-1);
+  dissipation = 0.5*c*der(x[1])^2 + sum(0.5*c*(der(x[i+1]) - der(x[i]))^2 for i in 1:n-1);
+end Chain;
+)";
+  Compiled scalar(text, false), looped(text, true);
+  const kernel::KernelModule &a = scalar.kernels(), &b = looped.kernels();
+  EXPECT_EQ(a.description.outputNames, (std::vector<std::string>{"E", "P", "centre", "ramp", "weights"}));
+  EXPECT_EQ(b.description.outputNames, a.description.outputNames);
+  for (int trial = 0; trial < 3; ++trial) {
+    std::vector<double> va = test::evaluateAt(a, trial).outputs, vb = test::evaluateAt(b, trial).outputs;
+    ASSERT_EQ(va.size(), 5u);
+    for (size_t i = 0; i < va.size(); ++i) EXPECT_NEAR(vb[i], va[i], 1e-13 * (1 + std::abs(va[i]))) << "output " << i;
+  }
+  // E: 2 sums, P: 1, ramp: 1 (the iterator as a number); centre divides sums (not a summand) and
+  // weights sums parameters only: expanded
+  EXPECT_EQ(loopCount(a.program(ModelProgram::Outputs)), 0u);
+  EXPECT_EQ(loopCount(b.program(ModelProgram::Outputs)), 4u);
+  EXPECT_EQ(test::opCount(b.program(ModelProgram::Outputs), kernel::Op::StoreAdd), 4u);
+  const flat::Output& E = looped.c.dae->outputs[0];
+  ASSERT_EQ(E.sums.size(), 2u);
+  EXPECT_EQ(E.sums[0].shape, (std::vector<int>{7}));
+  EXPECT_TRUE(looped.c.dae->outputs[4].sums.empty());
+}
+
 TEST(LoopedKernels, SpringChainGivesTheScalarResidualAndJacobian) {
   size_t loops = expectSameKernels(R"(model Chain
   parameter Integer n = 9;
