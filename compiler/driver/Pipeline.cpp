@@ -263,9 +263,9 @@ bool flatten(Compilation& c) {
     }
     if (templates) shapeOutputSums(*model, c.ctx);
     if (model && !templates) {
-      if (!readsIterators(*model, c.ctx) || c.diags.hasErrors()) {
+      if ((!model->templatesRound && !readsIterators(*model, c.ctx)) || c.diags.hasErrors()) {
         flat::expandIndexedSums(*model, c.ctx);  // exactly the scalar lowering's nodes
-      } else {  // an iterator's value folds in another order than the scalar lowering's: flatten again
+      } else {  // an iterator's value or a factor folds in another order than the scalar lowering: flatten again
         model.reset();
         c.ctx.clear();
         limits.keepLoops = false;

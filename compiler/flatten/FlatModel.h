@@ -275,6 +275,10 @@ struct FlatModel {
   std::vector<IndexedSum> indexedSums;
   std::vector<IndexedForce> indexedForces;  ///< `force(x[i]) = …` in `for` loops, kept as templates
   std::shared_ptr<ElementPatterns> patterns = std::make_shared<ElementPatterns>();
+  /// A template or summand was lowered with a factor distributed over a sum (`0.5*m*sum(…)`) or
+  /// reads an iterator as a number: expanded, the model equals the scalar lowering to rounding,
+  /// not node for node (the pipeline then flattens again rather than expand).
+  bool templatesRound = false;
   /// `for` equations kept as templates (FlattenLimits::keepForEquations); their points are not in
   /// `equations`.
   std::vector<EquationTemplate> equationTemplates;

@@ -129,6 +129,7 @@ std::optional<FlatModel> Flattener::run() {
   guarded([&] { instantiate(root); });
   for (Instance& inst : instances_) declareInstance(inst);  // variables in instance order
   for (Instance& inst : instances_) lowerInstance(inst);
+  resolveDeferred();
   cur_ = &root;
   if (diags_.errorCount() == errorsBefore) guarded([&] { connectAll(); });
   guarded([&] { lowerExperiment(); });
@@ -142,8 +143,19 @@ void Flattener::declareInstance(Instance& inst) {
     const sema::ModelSymbol& s = inst.cls->symbols.at(d->name);
     if (s.kind != sema::SymbolKind::Component)
       guarded([&] {
-        if (!limits_.keepLoops || !lowerOutputKeepingSums(inst, s)) valueOf(inst, s, d->nameRange);
+        if (!limits_.keepLoops || (!lowerOutputKeepingSums(inst, s) && !defersDefinition(inst, s)))
+          valueOf(inst, s, d->nameRange);
       });
+  }
+}
+
+// The deferred definitions no statement inlined, resolved as at their declarations (their
+// diagnostics); those inlined were lowered there, summand by summand, with theirs.
+void Flattener::resolveDeferred() {
+  for (const DeclKey& key : deferred_) {
+    if (inlined_.count(&key.slot()) || key.slot().state != Instance::Slot::Empty) continue;
+    cur_ = key.inst;
+    guarded([&] { valueOf(*key.inst, *key.symbol, key.symbol->decl->nameRange); });
   }
 }
 

@@ -7,6 +7,7 @@
 #include <initializer_list>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
@@ -168,10 +169,17 @@ struct TemplateIterator {
   long first = 0, last = 0;
 };
 
-/// A top-level summand of an energy statement and its sign.
+/// A top-level summand of an energy statement or an output, its sign, and the factors it is
+/// multiplied by (`0.5*m*sum(…)`: the summand `sum(…)` with the factor `0.5*m`; divide: 1/factor),
+/// outermost first.
 struct Summand {
+  struct Factor {
+    const ast::Expr* expr;
+    bool divide;
+  };
   const ast::Expr* expr;
   bool negated;
+  std::vector<Factor> factors;
 };
 
 class Flattener {
@@ -291,6 +299,19 @@ class Flattener {
 
   // IndexedSums.cpp (FlattenLimits::keepLoops)
   void addTermsKeepingLoops(std::vector<Term>& into, const ast::MechanicsStmt& st, const char* what);
+  void collectSummands(const ast::Expr& e, std::vector<Summand>& out, const ast::Declaration* own);
+  void collectSummands(const ast::Expr& e, bool negated, std::vector<Summand::Factor>& factors,
+                       std::vector<Summand>& out, std::vector<const ast::Declaration*>& through);
+  bool hasSumSummand(const ast::Expr& e, std::vector<const ast::Declaration*>& through);
+  bool mayContainSum(const ast::Expr& e);
+  bool lowerSummand(const Summand& t, const char* what, IndexedSum& sum, sym::Expr& value);
+  sym::Expr withFactors(sym::Expr v, const Summand& t);
+  const ast::Declaration* substitutedDefinition(const ast::Expr& e);
+  bool readsOnlyCoordinatesAndData(const ast::Expr& e, std::vector<std::string>& its, int declaredBefore);
+  bool defersDefinition(Instance& inst, const sema::ModelSymbol& s);
+  void resolveDeferred();
+  std::vector<DeclKey> deferred_;                    ///< definitions waiting to be inlined (defersDefinition)
+  std::set<const Instance::Slot*> inlined_;          ///< definitions whose bindings statements inlined
   bool lowerIndexedSum(const ast::CallExpr& call, bool negated, IndexedSum& sum);
   bool lowerOutputKeepingSums(Instance& inst, const sema::ModelSymbol& s);
   /// The outputs lowered with their sums kept (lowerOutputKeepingSums), by declaration: a later use

@@ -134,20 +134,6 @@ bool mentions(const ast::Expr* e, const std::vector<TemplateIterator>& its) {
   }
 }
 
-// The top-level summands of an energy statement, with their signs.
-void collectSummands(const ast::Expr& e, bool negated, std::vector<Summand>& out) {
-  if (auto* b = dyn_cast<BinaryExpr>(&e); b && (b->op == BinaryOp::Add || b->op == BinaryOp::Sub)) {
-    collectSummands(*b->lhs, negated, out);
-    collectSummands(*b->rhs, b->op == BinaryOp::Sub ? !negated : negated, out);
-    return;
-  }
-  if (auto* u = dyn_cast<UnaryExpr>(&e); u && u->op != UnaryOp::Not) {
-    collectSummands(*u->operand, u->op == UnaryOp::Neg ? !negated : negated, out);
-    return;
-  }
-  out.push_back({&e, negated});
-}
-
 const CallExpr* sumCall(const ast::Expr& e) {
   auto* c = dyn_cast<CallExpr>(&e);
   if (!c || c->callee->dotted() != "sum" || c->args.size() != 1 || !c->namedArgs.empty()) return nullptr;
@@ -156,21 +142,222 @@ const CallExpr* sumCall(const ast::Expr& e) {
 
 }  // namespace
 
+// The top-level summands of an energy statement or an output's binding, with their signs. A
+// summand naming a scalar definition of this instance (`kinetic = T;` with `Real T = sum(…) + …;`)
+// stands for the summands of its binding: definitions are substituted where they are used, so its
+// sums are this statement's (outside `for` loops only, where no iterator can capture a name of the
+// binding; a cycle of definitions is left to the usual lowering to report). A product or quotient
+// with sums on one side only (`0.5*m*sum(…)`, `0.5*k*(x[1]^2 + sum(…))`, `sum(…)/n`) gives that
+// side's summands the other side as a factor; elsewhere a product is one summand.
+void Flattener::collectSummands(const ast::Expr& e, bool negated, std::vector<Summand::Factor>& factors,
+                                std::vector<Summand>& out, std::vector<const ast::Declaration*>& through) {
+  if (auto* b = dyn_cast<BinaryExpr>(&e); b && (b->op == BinaryOp::Add || b->op == BinaryOp::Sub)) {
+    collectSummands(*b->lhs, negated, factors, out, through);
+    collectSummands(*b->rhs, b->op == BinaryOp::Sub ? !negated : negated, factors, out, through);
+    return;
+  }
+  if (auto* u = dyn_cast<UnaryExpr>(&e); u && u->op != UnaryOp::Not) {
+    collectSummands(*u->operand, u->op == UnaryOp::Neg ? !negated : negated, factors, out, through);
+    return;
+  }
+  if (auto* b = dyn_cast<BinaryExpr>(&e); b && (b->op == BinaryOp::Mul || b->op == BinaryOp::Div) && mayContainSum(e)) {
+    const ast::Expr *factor = nullptr, *summands = nullptr;
+    if (!mayContainSum(*b->rhs) && hasSumSummand(*b->lhs, through)) factor = b->rhs.get(), summands = b->lhs.get();
+    else if (b->op == BinaryOp::Mul && !mayContainSum(*b->lhs) && hasSumSummand(*b->rhs, through))
+      factor = b->lhs.get(), summands = b->rhs.get();
+    if (factor) {
+      factors.push_back({factor, b->op == BinaryOp::Div});
+      collectSummands(*summands, negated, factors, out, through);
+      factors.pop_back();
+      return;
+    }
+  }
+  // (at most kMaxInlined deep: a chain of definitions as long as the model is the work list's)
+  constexpr size_t kMaxInlined = 8;
+  const ast::Declaration* d = through.size() < kMaxInlined ? substitutedDefinition(e) : nullptr;
+  if (d && std::find(through.begin(), through.end(), d) == through.end()) {
+    inlined_.insert(&cur_->slots[cur_->cls->find(d->name)->index]);
+    through.push_back(d);
+    collectSummands(*d->binding, negated, factors, out, through);
+    through.pop_back();
+    return;
+  }
+  out.push_back({&e, negated, factors});
+}
+
+void Flattener::collectSummands(const ast::Expr& e, std::vector<Summand>& out, const ast::Declaration* own) {
+  std::vector<const ast::Declaration*> through;
+  if (own) through.push_back(own);
+  std::vector<Summand::Factor> factors;
+  collectSummands(e, false, factors, out, through);
+}
+
+// Whether some summand of e (collectSummands) is a sum(…) call.
+bool Flattener::hasSumSummand(const ast::Expr& e, std::vector<const ast::Declaration*>& through) {
+  std::vector<Summand> summands;
+  std::vector<Summand::Factor> factors;
+  std::set<const Instance::Slot*> inlined = inlined_;  // only looking: nothing is inlined yet
+  collectSummands(e, false, factors, summands, through);
+  inlined_ = std::move(inlined);
+  return std::any_of(summands.begin(), summands.end(), [](const Summand& t) { return sumCall(*t.expr) != nullptr; });
+}
+
+// Whether e may contain a sum(…) call: one written in it, or a name of a definition (whose
+// binding might have one). A factor must not: products of sums are not linear in either.
+bool Flattener::mayContainSum(const ast::Expr& e) {
+  switch (e.kind) {
+    case ExprKind::Number:
+    case ExprKind::Bool:
+    case ExprKind::String:
+    case ExprKind::End: return false;
+    case ExprKind::Name: {
+      auto* n = cast<NameExpr>(&e);
+      const sema::ModelSymbol* s = n->parts.size() == 1 ? cur_->cls->find(n->parts[0]) : nullptr;
+      return s && s->kind == sema::SymbolKind::Definition;
+    }
+    case ExprKind::Index: return mayContainSum(*cast<IndexExpr>(&e)->base);
+    case ExprKind::Unary: return mayContainSum(*cast<UnaryExpr>(&e)->operand);
+    case ExprKind::Binary: return mayContainSum(*cast<BinaryExpr>(&e)->lhs) || mayContainSum(*cast<BinaryExpr>(&e)->rhs);
+    case ExprKind::Call: {
+      auto* c = cast<CallExpr>(&e);
+      return c->callee->dotted() == "sum" || std::any_of(c->args.begin(), c->args.end(), [&](const ExprPtr& a) { return mayContainSum(*a); });
+    }
+    default: return true;
+  }
+}
+
+// One summand: its sum kept as a template (true; `sum` has the body with the summand's sign and
+// factors), or its value lowered (false; `value`). A factor makes the expanded template equal to
+// the scalar lowering to rounding only (FlatModel::templatesRound).
+bool Flattener::lowerSummand(const Summand& t, const char* what, IndexedSum& sum, Expr& value) {
+  if (const CallExpr* c = sumCall(*t.expr); c && !m_.calls.count(c) && lowerIndexedSum(*c, t.negated, sum)) {
+    sum.body = withFactors(sum.body, t);
+    out_.templatesRound |= !t.factors.empty();
+    return true;
+  }
+  Expr v = lowerScalar(*t.expr, what);
+  value = withFactors(t.negated ? ctx_.neg(v) : v, t);
+  out_.templatesRound |= !t.factors.empty();
+  return false;
+}
+
+// v times the summand's factors, the innermost first (a*(b*v)).
+Expr Flattener::withFactors(Expr v, const Summand& t) {
+  for (auto f = t.factors.rbegin(); f != t.factors.rend(); ++f) {
+    Expr x = lowerScalar(*f->expr, "a factor of a sum");
+    v = f->divide ? ctx_.div(v, x) : ctx_.mul(x, v);
+  }
+  return v;
+}
+
+// The declaration a plain name `T` stands for where its own binding is its value: a scalar
+// definition of the current instance, not an output, that no modifier binds, outside loops; else
+// nullptr.
+const ast::Declaration* Flattener::substitutedDefinition(const ast::Expr& e) {
+  auto* n = dyn_cast<NameExpr>(&e);
+  if (!n || n->parts.size() != 1 || !iterators_.empty() || !templateIterators_.empty()) return nullptr;
+  const sema::ModelSymbol* s = cur_->cls->find(n->parts[0]);
+  // (not an output: where the scalar lowering resolves one, its column comes first)
+  if (!s || s->kind != sema::SymbolKind::Definition || s->decl->causality == Causality::Output || !s->decl->binding ||
+      !s->decl->typeDims.empty() || !s->decl->dims.empty())
+    return nullptr;
+  return modifierOf(*cur_, *s->decl) ? nullptr : s->decl;
+}
+
+// Whether an expression reads nothing but numbers, `time`, the comprehensions' own iterators and
+// the current instance's coordinates, parameters and constants declared before declaration
+// `declaredBefore` (by plain names; der() of a coordinate is its velocity, made with it): lowering
+// it makes no variable and resolves no declaration not resolved already, so when it is lowered
+// does not matter.
+bool Flattener::readsOnlyCoordinatesAndData(const ast::Expr& e, std::vector<std::string>& its, int declaredBefore) {
+  auto all = [&](const std::vector<ExprPtr>& es) {
+    return std::all_of(es.begin(), es.end(), [&](const ExprPtr& x) { return !x || readsOnlyCoordinatesAndData(*x, its, declaredBefore); });
+  };
+  switch (e.kind) {
+    case ExprKind::Number:
+    case ExprKind::Bool:
+    case ExprKind::String:
+    case ExprKind::End: return true;
+    case ExprKind::Name: {
+      auto* n = cast<NameExpr>(&e);
+      if (n->parts.size() != 1) return false;
+      if (std::find(its.begin(), its.end(), n->parts[0]) != its.end()) return true;
+      const sema::ModelSymbol* s = cur_->cls->find(n->parts[0]);
+      if (!s) return n->parts[0] == "time";
+      bool data = s->kind == sema::SymbolKind::Coordinate || s->kind == sema::SymbolKind::Parameter ||
+                  s->kind == sema::SymbolKind::IntegerParameter || s->kind == sema::SymbolKind::Constant;
+      return data && s->index < declaredBefore;
+    }
+    case ExprKind::Index: {
+      auto* x = cast<IndexExpr>(&e);
+      return readsOnlyCoordinatesAndData(*x->base, its, declaredBefore) && all(x->subscripts);
+    }
+    case ExprKind::Unary: return readsOnlyCoordinatesAndData(*cast<UnaryExpr>(&e)->operand, its, declaredBefore);
+    case ExprKind::Binary:
+      return readsOnlyCoordinatesAndData(*cast<BinaryExpr>(&e)->lhs, its, declaredBefore) &&
+             readsOnlyCoordinatesAndData(*cast<BinaryExpr>(&e)->rhs, its, declaredBefore);
+    case ExprKind::Call: {
+      auto* c = cast<CallExpr>(&e);
+      return all(c->args) && std::all_of(c->namedArgs.begin(), c->namedArgs.end(), [&](const NamedArg& a) {
+               return !a.value || readsOnlyCoordinatesAndData(*a.value, its, declaredBefore);
+             });
+    }
+    case ExprKind::Range: {
+      auto* r = cast<RangeExpr>(&e);
+      return (!r->start || readsOnlyCoordinatesAndData(*r->start, its, declaredBefore)) &&
+             (!r->step || readsOnlyCoordinatesAndData(*r->step, its, declaredBefore)) && (!r->stop || readsOnlyCoordinatesAndData(*r->stop, its, declaredBefore));
+    }
+    case ExprKind::Array: return all(cast<ArrayExpr>(&e)->elements);
+    case ExprKind::Comprehension: {
+      auto* c = cast<ComprehensionExpr>(&e);
+      size_t outer = its.size();
+      bool ok = true;
+      for (const auto& it : c->iterators) {
+        ok = ok && (!it.range || readsOnlyCoordinatesAndData(*it.range, its, declaredBefore));
+        its.push_back(it.name);
+      }
+      ok = ok && readsOnlyCoordinatesAndData(*c->body, its, declaredBefore);
+      its.resize(outer);
+      return ok;
+    }
+    case ExprKind::If: {
+      auto* f = cast<IfExpr>(&e);
+      return all(f->conditions) && all(f->values) && (!f->elseValue || readsOnlyCoordinatesAndData(*f->elseValue, its, declaredBefore));
+    }
+    default: return false;
+  }
+}
+
+// A scalar definition (not an output) whose binding has sums as summands and reads only
+// coordinates and data (readsOnlyCoordinatesAndData): with templates, an energy statement or an
+// output that names it lowers its binding summand by summand (collectSummands), so resolving it
+// at its declaration would only expand its sums for nothing. It waits (deferred_): still unused
+// after everything else, it is resolved then (for its diagnostics), unless a statement inlined it.
+bool Flattener::defersDefinition(Instance& inst, const sema::ModelSymbol& s) {
+  const ast::Declaration& d = *s.decl;
+  if (s.kind != sema::SymbolKind::Definition || d.causality == Causality::Output || !d.binding ||
+      !d.typeDims.empty() || !d.dims.empty() || modifierOf(inst, d))
+    return false;
+  std::vector<std::string> its;
+  if (!readsOnlyCoordinatesAndData(*d.binding, its, s.index)) return false;
+  std::vector<Summand> summands;  // (no definition to go through: it reads none)
+  collectSummands(*d.binding, summands, &d);
+  if (std::none_of(summands.begin(), summands.end(), [](const Summand& t) { return sumCall(*t.expr) != nullptr; }))
+    return false;
+  deferred_.push_back({&inst, &s});
+  return true;
+}
+
 void Flattener::addTermsKeepingLoops(std::vector<Term>& into, const MechanicsStmt& st, const char* what) {
   std::vector<Summand> summands;
-  collectSummands(*st.value, false, summands);
+  collectSummands(*st.value, summands, nullptr);
   std::vector<Expr> scalars;
   std::vector<IndexedSum> sums;
   for (const Summand& s : summands) {
-    if (const CallExpr* c = sumCall(*s.expr); c && !m_.calls.count(c)) {
-      IndexedSum sum;
-      if (lowerIndexedSum(*c, s.negated, sum)) {
-        sums.push_back(std::move(sum));
-        continue;
-      }
-    }
-    Expr v = lowerScalar(*s.expr, what);
-    scalars.push_back(s.negated ? ctx_.neg(v) : v);
+    IndexedSum sum;
+    Expr value = nullptr;
+    if (lowerSummand(s, what, sum, value)) sums.push_back(std::move(sum));
+    else scalars.push_back(value);
   }
   IndexedSum::Energy energy = st.kind == MechanicsKind::Kinetic     ? IndexedSum::Energy::Kinetic
                               : st.kind == MechanicsKind::Potential ? IndexedSum::Energy::Potential
@@ -196,28 +383,29 @@ bool Flattener::lowerOutputKeepingSums(Instance& inst, const sema::ModelSymbol& 
       modifierOf(inst, d))
     return false;
   std::vector<Summand> summands;
-  collectSummands(*d.binding, false, summands);
+  collectSummands(*d.binding, summands, &d);
   auto isSum = [&](const Summand& t) { const CallExpr* c = sumCall(*t.expr); return c && !m_.calls.count(c); };
   if (std::none_of(summands.begin(), summands.end(), isSum)) return false;
   slot.state = Instance::Slot::Pending;  // a binding that reads its own output is a cycle (E0312)
+  bool rounded = out_.templatesRound;
   std::vector<Expr> scalars;
   std::vector<IndexedTerm> sums;
   try {
     for (const Summand& t : summands) {
       IndexedSum sum;
-      if (isSum(t) && lowerIndexedSum(*sumCall(*t.expr), t.negated, sum)) {
-        sums.push_back({std::move(sum.box), {}, sum.body});
-        continue;
-      }
-      Expr v = lowerScalar(*t.expr, "an output");
-      scalars.push_back(t.negated ? ctx_.neg(v) : v);
+      Expr value = nullptr;
+      if (lowerSummand(t, "an output", sum, value)) sums.push_back({std::move(sum.box), {}, sum.body});
+      else scalars.push_back(value);
     }
   } catch (...) {
     slot.state = Instance::Slot::Failed;
     throw;
   }
   slot.state = Instance::Slot::Empty;
-  if (sums.empty()) return false;  // lowered as usual (again: its side effects are made already, in the same order)
+  if (sums.empty()) {  // lowered as usual (again: its side effects are made already, in the same order)
+    out_.templatesRound = rounded;
+    return false;
+  }
   keptOutputs_[&slot] = out_.outputs.size();
   out_.outputs.push_back({d.name, ctx_.add(scalars), d.nameRange, outputKind(d), std::move(sums)});
   return true;

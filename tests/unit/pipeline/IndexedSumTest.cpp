@@ -356,6 +356,84 @@ TEST(IndexedSum, AnOutputSumReadingItselfIsTheUsualCycleError) {
   EXPECT_NE(rendered.str().find("error[E0312]: the definition of 'P' depends on itself"), std::string::npos) << rendered.str();
 }
 
+// `kinetic = T` with `Real T = sum(…)`: the definition's binding is the statement's (definitions are
+// substituted), so its sums are kept; expanded, node for node the scalar terms (no factor).
+TEST(IndexedSum, EnergiesThroughDefinitionsKeepTheirSums) {
+  test::SourceDae s("defs.qd", R"(model Defs
+  parameter Integer n = 6;
+  parameter Real m = 1, k = 1000;
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+  Real T = sum(0.5*m*der(x[i])^2 for i in 1:n);
+  Real springs = sum(0.5*k*(x[i+1] - x[i])^2 for i in 1:n-1);
+  Real V = 0.5*k*x[1]^2 + springs;
+mechanics
+  kinetic = T;
+  potential = V;
+end Defs;
+)", driver::Stage::Check);
+  Flattened f = flattenBoth(s);
+  ASSERT_TRUE(f.templated);
+  EXPECT_EQ(f.templated->indexedSums.size(), 2u);  // T's, and springs' through V
+  EXPECT_FALSE(f.templated->templatesRound);
+  expectExpandsToScalar(s, f);
+}
+
+// Factors over sums (`0.5*m*sum(…)`, `k*(x[1]^2 + sum(…))/2`): kept, each body times its factors;
+// expanded, equal to the scalar terms to rounding (FlatModel::templatesRound says so). A product of
+// two sums is not linear in either: one scalar term.
+TEST(IndexedSum, FactorsOverSumsAreTheBodiesFactors) {
+  test::SourceDae s("factors.qd", R"(model Factors
+  parameter Integer n = 6;
+  parameter Real m = 1, k = 1000, e = 0.001;
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+mechanics
+  kinetic = 0.5*m*sum(der(x[i])^2 for i in 1:n);
+  potential = k*(x[1]^2 + sum((x[i+1] - x[i])^2 for i in 1:n-1))/2 - sum(x[i] for i in 1:n)*e*sum(x[i] for i in 1:n);
+end Factors;
+)", driver::Stage::Check);
+  Flattened f = flattenBoth(s);
+  ASSERT_TRUE(f.scalar && f.templated);
+  EXPECT_EQ(f.templated->indexedSums.size(), 2u);
+  EXPECT_TRUE(f.templated->templatesRound);
+  flat::expandIndexedSums(*f.templated, s.ctx);
+  std::vector<double> values(s.ctx.symbolCount());
+  for (size_t i = 0; i < values.size(); ++i) values[i] = 0.3 + 0.7 * std::sin(1.0 + 1.7 * static_cast<double>(i));
+  for (auto [a, b] : {std::pair{&f.scalar->kinetic, &f.templated->kinetic}, {&f.scalar->potential, &f.templated->potential}}) {
+    ASSERT_EQ(a->size(), b->size());
+    for (size_t t = 0; t < a->size(); ++t) {
+      double va = sym::evaluate((*a)[t].value, values), vb = sym::evaluate((*b)[t].value, values);
+      EXPECT_NEAR(vb, va, 1e-13 * (1 + std::abs(va)));
+    }
+  }
+}
+
+// A definition that only a statement inlines is not resolved on its own (its sums would be
+// expanded for nothing), but its errors are reported once, there; one nothing uses is resolved
+// at the end, and its errors reported as before.
+TEST(IndexedSum, InlinedAndUnusedDefinitionsReportTheirErrorsOnce) {
+  for (bool used : {true, false}) {
+    std::string text = R"(model Bad
+  parameter Integer n = 6;
+  parameter Real m = 1;
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+  Real T = sum(0.5*m*der(x[i])^2 for i in 1:n) + x[n+1];
+mechanics
+  kinetic = )" + std::string(used ? "T" : "sum(0.5*m*der(x[i])^2 for i in 1:n)") + R"(;
+end Bad;
+)";
+    test::SourceDae s("bad.qd", text, driver::Stage::Check);
+    flat::FlattenLimits keep;
+    keep.keepLoops = true;
+    EXPECT_FALSE(flat::flatten(*s.compilation.checked, s.ctx, s.diags, keep));
+    std::ostringstream rendered;
+    s.diags.render(rendered, s.sources);
+    std::string text2 = rendered.str();
+    size_t first = text2.find("error[E0301]");
+    EXPECT_NE(first, std::string::npos) << text2;
+    EXPECT_EQ(text2.find("error[E0301]", first + 1), std::string::npos) << "reported twice:\n" << text2;
+  }
+}
+
 TEST(TemplateRows, ChainInteriorIsOneTemplateAndEqualsTheScalarRows) {
   std::string chain = kChain;
   auto rows = expectRowsMatchScalarDerivation("chain.qd", chain.c_str());

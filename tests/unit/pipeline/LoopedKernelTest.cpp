@@ -294,6 +294,47 @@ end Chain;
   EXPECT_TRUE(looped.c.dae->outputs[4].sums.empty());
 }
 
+// The ways of writing the same chain that users write: energies through definitions (`kinetic =
+// T;` with `Real T = sum(…)`), sums scaled by factors (`0.5*m*sum(…)`, `0.5*k*(x[1]^2 + sum(…))`,
+// `sum(…)/2`), an output that scales a definition (`P = -2*D`). Each keeps its sums as loops, with
+// the scalar residual, Jacobian and outputs.
+constexpr const char* kChainThroughDefinitions = R"(model Written
+  parameter Integer n = 9;
+  parameter Real m = 1.5, k = 800, c = 0.4;
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+  Real T = 0.5*m*sum(der(x[i])^2 for i in 1:n);
+  Real V = 0.5*k*(x[1]^2 + sum((x[i+1] - x[i])^2 for i in 1:n-1));
+  Real D = sum(c*(der(x[i+1]) - der(x[i]))^2 for i in 1:n-1)/2 + 0.5*c*der(x[1])^2;
+  output Real E = T + V;
+  output Real P = -2*D;
+mechanics
+  kinetic = T;
+  potential = V;
+  dissipation = D;
+end Written;
+)";
+
+TEST(LoopedKernels, EnergiesThroughDefinitionsAndFactorsKeepTheLoops) {
+  EXPECT_EQ(expectSameKernels(kChainThroughDefinitions), 2u);  // the interior's rows, the kinematic rows
+  Compiled scalar(kChainThroughDefinitions, false), looped(kChainThroughDefinitions, true);
+  const kernel::KernelModule &a = scalar.kernels(), &b = looped.kernels();
+  EXPECT_EQ(b.description.outputNames, (std::vector<std::string>{"E", "P"}));
+  for (int trial = 0; trial < 3; ++trial) {
+    std::vector<double> va = test::evaluateAt(a, trial).outputs, vb = test::evaluateAt(b, trial).outputs;
+    for (size_t i = 0; i < va.size(); ++i) EXPECT_NEAR(vb[i], va[i], 1e-13 * (1 + std::abs(va[i]))) << "output " << i;
+  }
+  EXPECT_EQ(loopCount(b.program(ModelProgram::Outputs)), 3u);  // E: T's and V's sums; P: D's
+}
+
+// A factor over a sum makes the expanded template equal to the scalar lowering to rounding only:
+// where the templates do not apply (here: an equation of an unknown), the model is flattened again
+// and compiles exactly as without templates.
+TEST(LoopedKernels, FactoredSumsFallBackToTheScalarLoweringExactly) {
+  std::string text = kChainThroughDefinitions;
+  text.replace(text.find("mechanics"), 9, "  Real y(start = 1);\nequation\n  der(y) = -y;\nmechanics");
+  test::expectScalarFallback(text);
+}
+
 TEST(LoopedKernels, SpringChainGivesTheScalarResidualAndJacobian) {
   size_t loops = expectSameKernels(R"(model Chain
   parameter Integer n = 9;
