@@ -583,7 +583,7 @@ void Flattener::lowerEquation(const ast::Equation& eq, std::vector<flat::Equatio
 void Flattener::lowerMechanics(const MechanicsStmt& st) {
   switch (st.kind) {
     case MechanicsKind::For:
-      if (limits_.keepLoops && iterators_.empty() && lowerForceTemplates(st)) return;
+      if (limits_.keepLoops && iterators_.empty() && lowerMechanicsLoop(st)) return;
       forEachIteration(st.iterators, 0, [&] {
         for (const auto& b : st.body) guarded([&] { lowerMechanics(b); });
       });

@@ -324,8 +324,9 @@ class Flattener {
   sym::Expr rateOfRelative(const RelativeElement& rel);
   bool addTemplateIterator(const ast::Iterator& it, std::vector<TemplateIterator>& its);
   bool lowerEquationTemplates(const ast::Equation& loop);
-  bool lowerForceTemplates(const ast::MechanicsStmt& loop);
+  bool lowerMechanicsLoop(const ast::MechanicsStmt& loop);
   std::optional<IndexedForce> lowerForceTemplate(const ast::MechanicsStmt& st, const std::vector<TemplateIterator>& its);
+  std::optional<IndexedSum> lowerEnergyTemplate(const ast::MechanicsStmt& st, const std::vector<TemplateIterator>& its);
   std::optional<std::vector<TemplateIterator>> equationTemplateIterators(const ast::Equation*& innermost);
   std::optional<EquationTemplate> lowerEquationTemplate(const ast::Equation& eq, const std::vector<TemplateIterator>& its);
   bool ratesOfUnknowns_ = false;  ///< lowering an equation template: der() of an array of unknowns is an array

@@ -581,9 +581,10 @@ std::optional<EquationTemplate> Flattener::lowerEquationTemplate(const ast::Equa
 // --- forces in `for` loops (FlattenLimits::keepLoops) ---
 
 // Every statement of a top-level mechanics loop (and of the loops nested in it while each holds only
-// the next) a force on `x[i + o, …]`, x an array of coordinates subscripted by the iterators in
-// order, as a template; or false (nothing recorded) where the scalar lowering must do the loop.
-bool Flattener::lowerForceTemplates(const MechanicsStmt& loop) {
+// the next) as a template: a force on `x[i + o, …]`, x an array of coordinates subscripted by the
+// iterators in order, or an energy statement (a sum over the loop's box); or false (nothing
+// recorded) where the scalar lowering must do the loop.
+bool Flattener::lowerMechanicsLoop(const MechanicsStmt& loop) {
   std::vector<TemplateIterator> its;
   const MechanicsStmt* inner = &loop;
   for (;;) {
@@ -594,15 +595,60 @@ bool Flattener::lowerForceTemplates(const MechanicsStmt& loop) {
   }
   if (inner->body.empty()) return false;
   std::vector<IndexedForce> forces;
+  std::vector<std::pair<const MechanicsStmt*, IndexedSum>> energies;
   for (const MechanicsStmt& st : inner->body) {
-    std::optional<IndexedForce> f = st.kind == MechanicsKind::Force ? lowerForceTemplate(st, its) : std::nullopt;
+    if (st.kind != MechanicsKind::Force) {
+      std::optional<IndexedSum> sum = lowerEnergyTemplate(st, its);
+      if (!sum) return false;
+      energies.push_back({&st, std::move(*sum)});
+      continue;
+    }
+    std::optional<IndexedForce> f = lowerForceTemplate(st, its);
     if (!f) return false;
     forces.push_back(std::move(*f));
   }
-  countScalars(pointCount(forces[0].box) * forces.size(), loop.range);
+  Box box;
+  for (const auto& it : its) box.push_back({it.first, it.last});
+  countScalars(pointCount(box) * inner->body.size(), loop.range);
   size_t first = out_.indexedForces.size();
   for (IndexedForce& f : forces) f.position = out_.forces.size(), f.first = first, out_.indexedForces.push_back(std::move(f));
+  // Each energy statement: one term its sum adds to (the scalar lowering's term per point and
+  // statement; expanded, equal to it to rounding, so the fallback flattens again).
+  for (auto& [st, sum] : energies) {
+    std::vector<Term>& into = st->kind == MechanicsKind::Kinetic     ? out_.kinetic
+                              : st->kind == MechanicsKind::Potential ? out_.potential
+                                                                     : out_.dissipation;
+    sum.term = static_cast<int>(into.size());
+    into.push_back({ctx_.zero(), st->range});
+    out_.indexedSums.push_back(std::move(sum));
+    out_.templatesRound = true;
+  }
   return true;
+}
+
+// `kinetic = e;` (potential, dissipation) inside a template loop: the sum of e over the loop's box.
+std::optional<IndexedSum> Flattener::lowerEnergyTemplate(const MechanicsStmt& st, const std::vector<TemplateIterator>& its) {
+  if (st.kind != MechanicsKind::Kinetic && st.kind != MechanicsKind::Potential && st.kind != MechanicsKind::Dissipation)
+    return std::nullopt;
+  if (!st.value || !TemplateCheck(its).body(*st.value)) return std::nullopt;
+  IndexedSum sum;
+  sum.energy = st.kind == MechanicsKind::Kinetic     ? IndexedSum::Energy::Kinetic
+               : st.kind == MechanicsKind::Potential ? IndexedSum::Energy::Potential
+                                                     : IndexedSum::Energy::Dissipation;
+  templateIterators_ = its;
+  try {
+    sum.body = lowerScalar(*st.value, "an energy");
+  } catch (NotATemplate&) {
+    templateIterators_.clear();
+    return std::nullopt;
+  } catch (...) {
+    templateIterators_.clear();
+    throw;
+  }
+  templateIterators_.clear();
+  for (const auto& it : its) sum.box.push_back({it.first, it.last});
+  sum.range = st.range;
+  return sum;
 }
 
 std::optional<IndexedForce> Flattener::lowerForceTemplate(const MechanicsStmt& st, const std::vector<TemplateIterator>& its) {

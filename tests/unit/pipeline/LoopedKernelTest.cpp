@@ -335,6 +335,39 @@ TEST(LoopedKernels, FactoredSumsFallBackToTheScalarLoweringExactly) {
   test::expectScalarFallback(text);
 }
 
+// Energies stated in `for` loops (`for i in 2:n loop potential = …; end for;`), next to a force
+// in the same loop and a grid's nested loops: each statement one sum over the loop's box, the
+// scalar kernels; where the templates do not apply, exactly the scalar lowering.
+constexpr const char* kEnergiesInLoops = R"(model Looped
+  parameter Integer n = 8;
+  parameter Real m = 1.2, k = 900, c = 0.3;
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+  coordinate Real z[3, 4](start = {{0.01*(i + j) for j in 1:4} for i in 1:3});
+mechanics
+  for i in 1:n loop
+    kinetic = 0.5*m*der(x[i])^2;
+  end for;
+  potential = 0.5*k*x[1]^2;
+  for i in 2:n loop
+    potential = 0.5*k*(x[i] - x[i-1])^2;
+    force(x[i]) = -c*der(x[i]);
+  end for;
+  for i in 1:3 loop
+    for j in 1:4 loop
+      kinetic = 0.5*der(z[i, j])^2;
+      potential = 0.5*k*z[i, j]^2 + 0.1*k*z[i, j]^4;
+    end for;
+  end for;
+end Looped;
+)";
+
+TEST(LoopedKernels, EnergiesInForLoopsAreSumsWithTheScalarKernels) {
+  EXPECT_GE(expectSameKernels(kEnergiesInLoops), 3u);
+  std::string text = kEnergiesInLoops;
+  text.replace(text.find("mechanics"), 9, "  Real y(start = 1);\nequation\n  der(y) = -y;\nmechanics");
+  test::expectScalarFallback(text);
+}
+
 TEST(LoopedKernels, SpringChainGivesTheScalarResidualAndJacobian) {
   size_t loops = expectSameKernels(R"(model Chain
   parameter Integer n = 9;
