@@ -122,7 +122,11 @@ FORMS = [("spring chain, energies", CHAIN, "x[1]"),
          ("spring chain, link forces f[i] as unknowns", "tests/sim/models/chain_forces.qd", "x[1]"),
          ("heat rod, `der(T[i]) = …`", "examples/heat/rod.qd", "T[1]"),
          ("graded chain: index as a number, forces in a loop", "tests/sim/models/graded_forced_chain.qd", "x[1]"),
-         ("heat rod, an initial equation per node", "tests/sim/models/rod_initial_profile.qd", "T[1]")]
+         ("heat rod, an initial equation per node", "tests/sim/models/rod_initial_profile.qd", "T[1]"),
+         ("damped chain, energy and power as outputs of sums", "tests/sim/models/chain_energy_outputs.qd", "E,P"),
+         ("chain through definitions and factors (`kinetic = T`, `0.5*m*sum(…)`)",
+          "tests/sim/models/chain_definitions.qd", "E,P"),
+         ("chain, energies and forces in `for` loops", "tests/sim/models/chain_for_energies.qd", "x[1]")]
 
 
 def forms(build, n, repeat):

@@ -117,11 +117,27 @@ class Deriver {
   bool addSummands(TermIndex& idx, Expr e, double sign) {
     bool allowed = true;
     if (e->kind == sym::Kind::Add) {
-      for (size_t i = 0; i < e->args.size(); ++i) allowed &= addTerm(idx, ctx_.scale(sign * e->coefs[i], e->args[i]));
+      for (size_t i = 0; i < e->args.size(); ++i) allowed &= addSummands(idx, ctx_.scale(sign * e->coefs[i], e->args[i]), 1.0);
+    } else if (Expr sum = distributedSum(e)) {
+      Expr rest = ctx_.div(e, sum);  // the other factors and the coefficient
+      for (size_t i = 0; i < sum->args.size(); ++i)
+        allowed &= addSummands(idx, ctx_.mul(rest, ctx_.scale(sign * sum->coefs[i], sum->args[i])), 1.0);
+      if (sum->value != 0) allowed &= addSummands(idx, ctx_.scale(sign * sum->value, rest), 1.0);
     } else if (!e->isConstant()) {
       allowed = addTerm(idx, ctx_.scale(sign, e));
     }
     return allowed;
+  }
+
+  // A product with a long sum among its factors (`0.5*m*(v1^2 + … + vn^2)`, a factor written
+  // outside a `sum(…)`): that sum, whose terms become terms of their own — one term containing
+  // every variable would be differentiated whole for each of them (n rows × n terms).
+  static Expr distributedSum(Expr e) {
+    constexpr size_t kLong = 8;
+    if (e->kind != sym::Kind::Mul) return nullptr;
+    for (size_t i = 0; i < e->args.size(); ++i)
+      if (e->args[i]->kind == sym::Kind::Add && e->args[i]->args.size() >= kLong && e->exps[i]->isOne()) return e->args[i];
+    return nullptr;
   }
 
   bool energyVariablesAllowed(Expr e) {
