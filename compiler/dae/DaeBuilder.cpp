@@ -20,6 +20,7 @@ class Builder {
       : m_(m), eom_(eom), ctx_(ctx), diags_(diags) {}
 
   std::optional<Dae> run() {
+    QDOT_ASSERT(m_.equationSums.empty(), "buildDae: an equation with sums the pipeline neither expanded nor made an output");
     size_t errorsBefore = diags_.errorCount();
     dae_.name = m_.name;
     dae_.description = m_.description;

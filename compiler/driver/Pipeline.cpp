@@ -157,17 +157,26 @@ std::optional<std::vector<int>> explicitDefinitions(const flat::FlatModel& m, co
   };
   auto overStates = [&](sym::Expr e) {
     for (sym::Expr s : ctx.freeSymbols(e)) {
-      int v = m.variableOf(s);
+      if (m.patterns->iteratorOf(s) >= 0) continue;  // a kept sum's iterator
+      const flat::RelativeElement* rel = m.relativeElement(s);  // an element of a kept sum
+      int v = m.variableOf(rel ? m.patterns->arrays[rel->array].elements[0] : s);
       VarRole r = v >= 0 ? m.variables[v].role : VarRole::Unknown;
       if (r != VarRole::Coordinate && r != VarRole::Velocity && r != VarRole::Parameter && r != VarRole::Time) return false;
     }
     return true;
   };
+  std::vector<const std::vector<flat::IndexedTerm>*> sumsOf(m.equations.size(), nullptr);
+  for (const auto& [index, sums] : m.equationSums) sumsOf[index] = &sums;
+  auto sumsOverStates = [&](size_t e) {
+    return !sumsOf[e] || std::all_of(sumsOf[e]->begin(), sumsOf[e]->end(), [&](const flat::IndexedTerm& t) { return overStates(t.body); });
+  };
   std::vector<int> defined;
   std::vector<char> seen(m.variables.size(), 0);
-  for (const flat::Equation& e : m.equations) {
+  for (size_t k = 0; k < m.equations.size(); ++k) {
+    const flat::Equation& e = m.equations[k];
     if (e.origin.kind != flat::OriginKind::Equation || !e.lhs || !e.rhs) return std::nullopt;
     int z = definable(e.lhs);
+    if (sumsOf[k] && (z < 0 || !overStates(e.rhs) || !sumsOverStates(k))) return std::nullopt;  // (its sums are the rhs')
     if (z < 0 || !overStates(e.rhs)) z = overStates(e.lhs) ? definable(e.rhs) : -1;
     if (z < 0 || seen[z]++) return std::nullopt;
     defined.push_back(z);
@@ -177,21 +186,54 @@ std::optional<std::vector<int>> explicitDefinitions(const flat::FlatModel& m, co
   return defined;
 }
 
+// Whether some expression of the model that the DAE substitutes aliases into reads symbol s (the
+// equations, each defining its own unknown over states and parameters, read no other unknown).
+bool readsSymbol(const flat::FlatModel& m, const sym::Context& ctx, sym::Expr s) {
+  auto reads = [&](sym::Expr e) { return e && ctx.dependsOn(e, s); };
+  for (const auto& [q, t] : m.forces)
+    if (reads(t.value)) return true;
+  for (const auto& f : m.indexedForces)
+    if (reads(f.body)) return true;
+  for (const auto& o : m.outputs) {
+    if (reads(o.value)) return true;
+    for (const auto& sum : o.sums)
+      if (reads(sum.body)) return true;
+  }
+  for (const auto* terms : {&m.kinetic, &m.potential, &m.dissipation})
+    for (const auto& t : *terms)
+      if (reads(t.value)) return true;
+  for (const auto& sum : m.indexedSums)
+    if (reads(sum.body)) return true;
+  for (const auto& e : m.initialEquations)
+    if (reads(e.residual)) return true;
+  for (const auto& e : m.constraints)
+    if (reads(e.residual)) return true;
+  for (const auto& v : m.variables)
+    if (reads(v.start) || reads(v.alias)) return true;
+  return false;
+}
+
 // The explicitly defined unknowns leave the system: each an alias of its value (the DAE
 // substitutes it wherever it is read, a force say) and an output, first among the outputs in the
 // order of the unknowns, as dae::eliminateExplicitAlgebraics places them.
-void defineAsOutputs(flat::FlatModel& m, const std::vector<int>& defined) {
+void defineAsOutputs(flat::FlatModel& m, const std::vector<int>& defined, sym::Context& ctx) {
   std::vector<std::pair<int, size_t>> order;  // (unknown, its equation)
   for (size_t e = 0; e < defined.size(); ++e) order.push_back({defined[e], e});
   std::sort(order.begin(), order.end());
+  std::vector<std::vector<flat::IndexedTerm>> sumsOf(m.equations.size());
+  for (auto& [index, sums] : m.equationSums) sumsOf[index] = std::move(sums);  // of `z = …` only
+  m.equationSums.clear();
   std::vector<flat::Output> outputs;
   for (auto [z, e] : order) {
     const flat::Equation& eq = m.equations[e];
     sym::Expr value = m.variableOf(eq.lhs) == z ? eq.rhs : eq.lhs;
-    m.variables[z].alias = value;
-    outputs.push_back({std::string(m.variables[z].name), value, eq.origin.range, flat::OutputKind::Plain});
+    // A force or an output that reads z reads its value: with kept sums, the whole of it (made only
+    // then: else nothing substitutes the alias).
+    bool read = !sumsOf[e].empty() && readsSymbol(m, ctx, m.variables[z].symbol);
+    m.variables[z].alias = read ? flat::withSumsExpanded(m, ctx, value, sumsOf[e]) : value;
+    outputs.push_back({std::string(m.variables[z].name), value, eq.origin.range, flat::OutputKind::Plain, std::move(sumsOf[e])});
   }
-  m.outputs.insert(m.outputs.begin(), outputs.begin(), outputs.end());
+  m.outputs.insert(m.outputs.begin(), std::make_move_iterator(outputs.begin()), std::make_move_iterator(outputs.end()));
   m.equations.clear();
 }
 
@@ -204,6 +246,9 @@ bool readsIterators(const flat::FlatModel& m, const sym::Context& ctx) {
     if (m.patterns->readsIterator(ctx, f.body)) return true;
   for (const auto& o : m.outputs)
     for (const auto& sum : o.sums)
+      if (m.patterns->readsIterator(ctx, sum.body)) return true;
+  for (const auto& [index, sums] : m.equationSums)
+    for (const auto& sum : sums)
       if (m.patterns->readsIterator(ctx, sum.body)) return true;
   return false;
 }
@@ -240,6 +285,7 @@ std::optional<flat::FlatModel> flattenKeepingEquations(Compilation& c, flat::Fla
   limits.keepForEquations = true;
   DiagnosticEngine attempt;
   auto model = flat::flatten(*c.checked, c.ctx, attempt, limits, c.options.structural);
+  if (model) flat::expandEquationSums(*model, c.ctx);  // (an explicit ODE's rows are scalars or `for` templates)
   if (model && attempt.diagnostics().empty() && !model->equationTemplates.empty() && dae::isTemplatedOde(*model, c.ctx))
     return model;
   model.reset();
@@ -258,7 +304,7 @@ bool flatten(Compilation& c) {
     if (model) defined = model->equations.empty() ? std::vector<int>{} : explicitDefinitions(*model, c.ctx);
     bool templates = model && defined && templatesApply(*model, c.options, c.ctx, *defined);
     if (templates && !defined->empty()) {
-      defineAsOutputs(*model, *defined);
+      defineAsOutputs(*model, *defined, c.ctx);
       c.eliminated.eliminated = defined->size();  // solved out as the scalar DAE would have them
     }
     if (templates) shapeOutputSums(*model, c.ctx);

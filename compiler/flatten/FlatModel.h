@@ -275,6 +275,11 @@ struct FlatModel {
   std::vector<IndexedSum> indexedSums;
   std::vector<IndexedForce> indexedForces;  ///< `force(x[i]) = …` in `for` loops, kept as templates
   std::shared_ptr<ElementPatterns> patterns = std::make_shared<ElementPatterns>();
+  /// Equations `z = … + sum(…)` of the model (z a scalar unknown, the sums over coordinates or
+  /// velocities) whose sums are kept as templates (FlattenLimits::keepLoops): by equation index, the
+  /// sums its rhs (and residual) leave out. The pipeline makes such an equation an output (z defined
+  /// explicitly) or expands them (expandIndexedSums); no stage after flattening sees them.
+  std::vector<std::pair<size_t, std::vector<IndexedTerm>>> equationSums;
   /// A template or summand was lowered with a factor distributed over a sum (`0.5*m*sum(…)`) or
   /// reads an iterator as a number: expanded, the model equals the scalar lowering to rounding,
   /// not node for node (the pipeline then flattens again rather than expand).

@@ -567,6 +567,9 @@ void Flattener::lowerEquation(const ast::Equation& eq, std::vector<flat::Equatio
   }
   if (eq.kind == EquationKind::Connect && kind == OriginKind::Equation && eq.lhs && eq.rhs) return lowerConnect(eq);
   if (eq.kind != EquationKind::Simple || !eq.lhs || !eq.rhs) return;  // sema reported the others
+  if (limits_.keepLoops && kind == OriginKind::Equation && iterators_.empty() && cur_ == &instances_.front() &&
+      lowerEquationKeepingSums(eq, into))
+    return;
   Value l = lower(*eq.lhs);
   Value r = lower(*eq.rhs);
   if (l.shape != r.shape)

@@ -53,8 +53,11 @@ sym::Expr instantiate(const FlatModel& model, sym::Context& ctx, sym::Expr body,
 /// points): what the scalar lowering gives for a binding `value + sum(…) + …`.
 sym::Expr withSumsExpanded(const FlatModel& model, sym::Context& ctx, sym::Expr value, const std::vector<IndexedTerm>& sums);
 
-/// Expands every IndexedSum into its energy term, every IndexedForce into its forces and every
-/// output's sums into its value (the model then is what flattening without keepLoops gives) and
+/// Adds the kept sums of equations (FlatModel::equationSums) to their right sides and residuals.
+void expandEquationSums(FlatModel& model, sym::Context& ctx);
+
+/// Expands every IndexedSum into its energy term, every IndexedForce into its forces, every
+/// equation's and output's sums into its sides and value (the model then is what flattening without keepLoops gives) and
 /// clears the templates.
 void expandIndexedSums(FlatModel& model, sym::Context& ctx);
 

@@ -314,6 +314,7 @@ class Flattener {
   std::set<const Instance::Slot*> inlined_;          ///< definitions whose bindings statements inlined
   bool lowerIndexedSum(const ast::CallExpr& call, bool negated, IndexedSum& sum);
   bool lowerOutputKeepingSums(Instance& inst, const sema::ModelSymbol& s);
+  bool lowerEquationKeepingSums(const ast::Equation& eq, std::vector<Equation>& into);
   /// The outputs lowered with their sums kept (lowerOutputKeepingSums), by declaration: a later use
   /// of the definition resolves it as usual, and its output then takes the expanded value.
   std::map<const Instance::Slot*, size_t> keptOutputs_;

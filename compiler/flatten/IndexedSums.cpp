@@ -411,6 +411,48 @@ bool Flattener::lowerOutputKeepingSums(Instance& inst, const sema::ModelSymbol& 
   return true;
 }
 
+// `z = … + sum(…)` in the model's equations, z a scalar unknown of the model: the equation with
+// the sums of its right side kept (FlatModel::equationSums) where one of them reads coordinates or
+// velocities — z is then no alias, and the pipeline makes the equation z's definition, an output
+// (driver/Pipeline.cpp), or expands the sums. Sums over parameters only are expanded here (the
+// equation may make z an alias); false (nothing recorded) where no sum was kept.
+bool Flattener::lowerEquationKeepingSums(const ast::Equation& eq, std::vector<Equation>& into) {
+  auto* name = dyn_cast<NameExpr>(eq.lhs.get());
+  const sema::ModelSymbol* z = name && name->parts.size() == 1 ? cur_->cls->find(name->parts[0]) : nullptr;
+  if (!z || z->kind != sema::SymbolKind::Unknown || !z->decl->typeDims.empty() || !z->decl->dims.empty()) return false;
+  std::vector<Summand> summands;
+  collectSummands(*eq.rhs, summands, nullptr);
+  if (std::none_of(summands.begin(), summands.end(), [](const Summand& t) { return sumCall(*t.expr) != nullptr; }))
+    return false;
+  bool rounded = out_.templatesRound;
+  Expr lhs = lowerScalar(*eq.lhs, "an equation");
+  std::vector<Expr> scalars;
+  std::vector<IndexedTerm> sums;
+  for (const Summand& t : summands) {
+    IndexedSum sum;
+    Expr value = nullptr;
+    if (lowerSummand(t, "an equation", sum, value)) sums.push_back({std::move(sum.box), {}, sum.body});
+    else scalars.push_back(value);
+  }
+  auto readsStates = [&](const IndexedTerm& sum) {
+    for (Expr s : ctx_.freeSymbols(sum.body))
+      if (const RelativeElement* rel = out_.relativeElement(s)) {
+        int var = out_.variableOf(out_.patterns->arrays[rel->array].elements[0]);
+        if (var >= 0 && out_.variables[var].role != VarRole::Parameter) return true;
+      }
+    return false;
+  };
+  if (std::none_of(sums.begin(), sums.end(), readsStates)) {
+    out_.templatesRound = rounded;
+    return false;  // lowered as usual (again: its side effects are made already, in the same order)
+  }
+  countScalars(1, eq.range);
+  Expr rhs = ctx_.add(scalars);
+  into.push_back({ctx_.sub(lhs, rhs), {OriginKind::Equation, eq.range, -1, "", cur_->index}, lhs, rhs});
+  out_.equationSums.push_back({into.size() - 1, std::move(sums)});
+  return true;
+}
+
 // Appends a loop's iterator `a:b` to `its` if it can be a template's: plain integer bounds that
 // name no earlier iterator, a range that is not empty, a name not taken by an earlier iterator.
 bool Flattener::addTemplateIterator(const ast::Iterator& it, std::vector<TemplateIterator>& its) {
@@ -837,7 +879,17 @@ Expr withSumsExpanded(const FlatModel& model, sym::Context& ctx, Expr value, con
   return value;
 }
 
+void expandEquationSums(FlatModel& model, sym::Context& ctx) {
+  for (const auto& [index, sums] : model.equationSums) {
+    Equation& e = model.equations[index];
+    e.rhs = withSumsExpanded(model, ctx, e.rhs, sums);
+    e.residual = ctx.sub(e.lhs, e.rhs);
+  }
+  model.equationSums.clear();
+}
+
 void expandIndexedSums(FlatModel& model, sym::Context& ctx) {
+  expandEquationSums(model, ctx);
   for (Output& o : model.outputs) {
     o.value = withSumsExpanded(model, ctx, o.value, o.sums);
     o.sums.clear();

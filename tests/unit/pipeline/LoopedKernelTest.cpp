@@ -368,6 +368,59 @@ TEST(LoopedKernels, EnergiesInForLoopsAreSumsWithTheScalarKernels) {
   test::expectScalarFallback(text);
 }
 
+// `Real E; equation E = sum(…) + …;` next to the energies: E is defined explicitly, so it becomes an
+// output with its sums as loops (as `qdot run` solves it out of the scalar system); a force that
+// reads E reads the whole of it. Residual, Jacobian and outputs are the scalar ones.
+TEST(LoopedKernels, AnUnknownDefinedBySumsIsAnOutputWithLoops) {
+  std::string text = R"(model ChainEq
+  parameter Integer n = 10;
+  parameter Real m = 1, k = 1000;
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+  Real E "energy [J]";
+mechanics
+  kinetic = sum(0.5*m*der(x[i])^2 for i in 1:n);
+  potential = 0.5*k*x[1]^2 + sum(0.5*k*(x[i+1] - x[i])^2 for i in 1:n-1);
+equation
+  E = sum(0.5*m*der(x[i])^2 for i in 1:n) + 0.5*k*x[1]^2 + sum(0.5*k*(x[i+1] - x[i])^2 for i in 1:n-1);
+end ChainEq;
+)";
+  for (bool forceReadsE : {false, true}) {
+    if (forceReadsE) text.replace(text.find("equation"), 8, "  force(x[n]) = -0.001*E;\nequation");
+    Compiled scalar(text, false, true), looped(text, true, true);
+    const kernel::KernelModule &a = scalar.kernels(), &b = looped.kernels();
+    EXPECT_EQ(loopCount(b.program(ModelProgram::Residual)), 2u) << forceReadsE;
+    EXPECT_EQ(b.description.outputNames, (std::vector<std::string>{"E"}));
+    EXPECT_EQ(a.description.outputNames, b.description.outputNames);
+    EXPECT_EQ(a.description.variableNames, b.description.variableNames);
+    EXPECT_EQ(loopCount(b.program(ModelProgram::Outputs)), 2u);
+    for (int trial = 0; trial < 3; ++trial) {
+      test::KernelValues va = test::evaluateAt(a, trial), vb = test::evaluateAt(b, trial);
+      for (size_t i = 0; i < va.F.size(); ++i) EXPECT_NEAR(vb.F[i], va.F[i], 1e-13 * (1 + std::abs(va.F[i]))) << "F[" << i << "]";
+      for (size_t i = 0; i < va.J.size(); ++i) EXPECT_NEAR(vb.J[i], va.J[i], 1e-13 * (1 + std::abs(va.J[i]))) << "J[" << i << "]";
+      ASSERT_EQ(va.outputs.size(), 1u);
+      EXPECT_NEAR(vb.outputs[0], va.outputs[0], 1e-13 * (1 + std::abs(va.outputs[0])));
+    }
+  }
+}
+
+// The same equation next to one that is no explicit definition: the templates do not apply, and
+// the sums expand into the equation as the scalar lowering writes it.
+TEST(LoopedKernels, AnEquationWithSumsInAScalarModelIsTheScalarOne) {
+  test::expectScalarFallback(R"(model ChainEq
+  parameter Integer n = 10;
+  parameter Real m = 1, k = 1000;
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+  Real E, y(start = 1);
+mechanics
+  kinetic = sum(0.5*m*der(x[i])^2 for i in 1:n);
+  potential = 0.5*k*x[1]^2 + sum(0.5*k*(x[i+1] - x[i])^2 for i in 1:n-1);
+equation
+  E = sum(0.5*m*der(x[i])^2 for i in 1:n) + 0.5*k*x[1]^2 + sum(0.5*k*(x[i+1] - x[i])^2 for i in 1:n-1);
+  der(y) = -y*E;
+end ChainEq;
+)");
+}
+
 TEST(LoopedKernels, SpringChainGivesTheScalarResidualAndJacobian) {
   size_t loops = expectSameKernels(R"(model Chain
   parameter Integer n = 9;
