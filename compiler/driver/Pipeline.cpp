@@ -18,6 +18,7 @@
 #include "bytecode/Emitter.h"
 #include "dae/IndexReduction.h"
 #include "dae/TemplateOde.h"
+#include "flatten/FlatPrinter.h"
 #include "syntax/Parser.h"
 
 namespace qdot::driver {
@@ -112,41 +113,54 @@ void shapeOutputSums(flat::FlatModel& m, sym::Context& ctx) {
   }
 }
 
+// Why the templates do not apply, in words for `qdot run --stats` ("" if they do; the model has
+// some: sums or force loops).
+std::string whyScalar(const flat::FlatModel& m, const CompileOptions& o, const sym::Context& ctx,
+                      const std::optional<std::vector<int>>& defined, size_t failing, const SourceManager& sm) {
+  if (!o.keepLoops) return "loops are off (--no-loops, or a command that works on scalars)";
+  if (!m.constraints.empty())
+    return "it has a constraint (" + flat::lineOf(sm, m.constraints[0].origin.range) + "): index reduction works on scalars";
+  if (m.components.size() > 1) return "it has components (" + m.components[1] + ", …): arrays of components are expanded";
+  if (!defined && failing < m.equations.size())
+    return "the equation at " + flat::lineOf(sm, m.equations[failing].origin.range) +
+           " does not define an algebraic unknown of its own over coordinates, velocities, parameters and time";
+  if (!dae::initialEquationsAreStartValues(m, ctx))
+    return "an initial equation (" + flat::lineOf(sm, m.initialEquations[0].origin.range) + ", …) is not a state's start value";
+  std::vector<char> isDefined(m.variables.size(), 0);
+  for (int z : defined ? *defined : std::vector<int>{}) isDefined[z] = 1;
+  for (size_t v = 0; v < m.variables.size(); ++v) {
+    const flat::Variable& var = m.variables[v];
+    if (var.alias) return "'" + std::string(var.name) + "' is an alias (connections and alias equations work on scalars)";
+    if (var.role == flat::VarRole::Derivative) return "'" + std::string(var.name) + "' is the rate of an unknown that is not a coordinate";
+    if (var.role == flat::VarRole::Unknown && !isDefined[v]) return "'" + std::string(var.name) + "' is an unknown no equation defines explicitly";
+  }
+  for (const auto& sum : m.indexedSums) {
+    const std::vector<int>* shape = nullptr;
+    if (!loopsRead(m, sum.body, sum.box.size(), shape, ctx))
+      return "the sum at " + flat::lineOf(sm, sum.range) + " reads an array a loop cannot address (arrays of parameters must " +
+             "be of the coordinates' shape, indexed by the iterators in order)";
+  }
+  for (const auto& f : m.indexedForces)
+    if (!loopsReadForce(m, f, ctx)) return "the force at " + flat::lineOf(sm, f.range) + " reads an array a loop cannot address";
+  return "";
+}
+
 // Where the stages after flattening take templates (docs/loops.md): a model of energies over
 // coordinates only — no constraints, components or aliases (their structural passes work on
 // scalars), equations only where they define algebraic unknowns explicitly, initial equations that
-// are start values at most. Its Jacobi integral is a
-// sum over every element: the kernels loop it too.
+// are start values at most. Its Jacobi integral is a sum over every element: the kernels loop it too.
 // `defined`: the algebraic unknowns the model's equations define explicitly (explicitDefinitions),
 // which become outputs: the equations may be those definitions.
-bool templatesApply(const flat::FlatModel& m, const CompileOptions& o, const sym::Context& ctx,
-                    const std::vector<int>& defined) {
-  if (!o.keepLoops || (m.indexedSums.empty() && m.indexedForces.empty())) return false;
-  if (m.equations.size() != defined.size() || !m.constraints.empty() || m.components.size() > 1) return false;
-  if (!dae::initialEquationsAreStartValues(m, ctx)) return false;
-  std::vector<char> isDefined(m.variables.size(), 0);
-  for (int z : defined) isDefined[z] = 1;
-  bool plain = true;
-  for (size_t v = 0; v < m.variables.size(); ++v) {
-    const flat::Variable& var = m.variables[v];
-    plain &= !var.alias && var.role != flat::VarRole::Derivative && (var.role != flat::VarRole::Unknown || isDefined[v]);
-  }
-  return plain &&
-         std::all_of(m.indexedSums.begin(), m.indexedSums.end(),
-                     [&](const flat::IndexedSum& sum) {
-                       const std::vector<int>* shape = nullptr;
-                       return loopsRead(m, sum.body, sum.box.size(), shape, ctx);
-                     }) &&
-         std::all_of(m.indexedForces.begin(), m.indexedForces.end(),
-                     [&](const flat::IndexedForce& f) { return loopsReadForce(m, f, ctx); });
-}
+bool hasTemplates(const flat::FlatModel& m) { return !m.indexedSums.empty() || !m.indexedForces.empty(); }
 
 // The equations of a model of energies that each define an algebraic unknown explicitly — `z =
 // expr` or `expr = z`, expr over coordinates, velocities, parameters and time — one per unknown,
-// every unknown of the model so defined: per equation, the unknown it defines; nullopt otherwise.
+// every unknown of the model so defined: per equation, the unknown it defines; nullopt otherwise,
+// `failing` the first equation that is no such definition (or the count of equations: an unknown
+// none defines).
 // (What dae::eliminateExplicitAlgebraics would solve out of the scalar DAE; with templates they
 // become outputs before the stages that need every row.)
-std::optional<std::vector<int>> explicitDefinitions(const flat::FlatModel& m, const sym::Context& ctx) {
+std::optional<std::vector<int>> explicitDefinitions(const flat::FlatModel& m, const sym::Context& ctx, size_t& failing) {
   using flat::VarRole;
   auto definable = [&](sym::Expr s) {
     int v = m.variableOf(s);
@@ -174,6 +188,7 @@ std::optional<std::vector<int>> explicitDefinitions(const flat::FlatModel& m, co
   std::vector<char> seen(m.variables.size(), 0);
   for (size_t k = 0; k < m.equations.size(); ++k) {
     const flat::Equation& e = m.equations[k];
+    failing = k;
     if (e.origin.kind != flat::OriginKind::Equation || !e.lhs || !e.rhs) return std::nullopt;
     int z = definable(e.lhs);
     if (sumsOf[k] && (z < 0 || !overStates(e.rhs) || !sumsOverStates(k))) return std::nullopt;  // (its sums are the rhs')
@@ -182,7 +197,7 @@ std::optional<std::vector<int>> explicitDefinitions(const flat::FlatModel& m, co
     defined.push_back(z);
   }
   for (size_t v = 0; v < m.variables.size(); ++v)
-    if (m.variables[v].role == VarRole::Unknown && !m.variables[v].alias && !seen[v]) return std::nullopt;
+    if (m.variables[v].role == VarRole::Unknown && !m.variables[v].alias && !seen[v]) return failing = m.equations.size(), std::nullopt;
   return defined;
 }
 
@@ -298,11 +313,27 @@ bool flatten(Compilation& c) {
     flat::FlattenLimits limits = c.options.limits;
     limits.keepLoops = true;
     if (forEquationsMayStay(c))
-      if (auto model = flattenKeepingEquations(c, limits)) return model;
+      if (auto model = flattenKeepingEquations(c, limits)) {
+        c.loops = "";
+        return model;
+      }
     auto model = flat::flatten(*c.checked, c.ctx, c.diags, limits, c.options.structural);
     std::optional<std::vector<int>> defined;
-    if (model) defined = model->equations.empty() ? std::vector<int>{} : explicitDefinitions(*model, c.ctx);
-    bool templates = model && defined && templatesApply(*model, c.options, c.ctx, *defined);
+    size_t failing = 0;
+    if (model) defined = model->equations.empty() ? std::vector<int>{} : explicitDefinitions(*model, c.ctx, failing);
+    bool repeated = model && (hasTemplates(*model) || std::any_of(model->outputs.begin(), model->outputs.end(),
+                                                                      [](const flat::Output& o) { return !o.sums.empty(); }) ||
+                              !model->equationSums.empty());
+    std::string why = model && hasTemplates(*model) ? whyScalar(*model, c.options, c.ctx, defined, failing, c.sources)
+                                                    : "its repeated structure is only in outputs or equations";
+    bool templates = model && defined && hasTemplates(*model) && why.empty();
+    if (repeated) c.loops = templates ? "" : why;
+    if (model && !repeated)
+      for (const std::string& path : model->components)
+        if (path.find('[') != std::string::npos) {
+          c.loops = "it has arrays of components (" + path + ", …), which are expanded";
+          break;
+        }
     if (templates && !defined->empty()) {
       defineAsOutputs(*model, *defined, c.ctx);
       c.eliminated.eliminated = defined->size();  // solved out as the scalar DAE would have them
@@ -335,6 +366,8 @@ bool buildDae(Compilation& c) {
     // A templated DAE is an ODE in the accelerations of one row per coordinate (index 1), and its
     // coordinates are coupled along the arrays: nothing to reduce, nothing worth pruning.
     if (d && d->templated()) return d;
+    if (d && c.loops && c.loops->empty())  // kept through flattening, but mechanics peeled every element
+      c.loops = "no region of elements shares its rows (each element's row is its own)";
     if (d && c.options.eliminateAlgebraics) c.eliminated = dae::eliminateExplicitAlgebraics(*d, c.ctx);
     if (d && !c.options.results.empty()) {
       std::vector<std::string> names = c.options.results;

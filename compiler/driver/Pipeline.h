@@ -84,6 +84,9 @@ struct Compilation {
   std::optional<dae::Dae> dae;
   dae::PruneReport pruned;  ///< what --outputs kept
   dae::EliminationReport eliminated;  ///< explicit algebraic unknowns solved out (eliminateAlgebraics)
+  /// Whether the model's repeated structure (sums, loops) is compiled as loops (docs/loops.md):
+  /// nullopt if it has none, "" if it is, else why it is expanded to scalars (`qdot run --stats`).
+  std::optional<std::string> loops;
   flat::Experiment experiment;  ///< the DAE's experiment annotation (kept when the DAE is released)
   std::shared_ptr<const kernel::KernelModule> kernels;
   std::optional<bc::Module> bytecode;

@@ -166,6 +166,9 @@ ExitCode run(driver::Compilation& c, Options& o) {
   if (!m.warning.empty()) std::cerr << "qdot: warning: " << m.warning << "\n";
   c.diags.render(std::cerr, c.sources, isatty(2));  // warnings, if any
   if (o.run.stats) printCompileStats(c.times, m);
+  if (o.run.stats && c.loops)
+    std::cerr << (c.loops->empty() ? "loops: the model's repeated structure is compiled as loops\n"
+                                   : "loops: the model's repeated structure is expanded to scalars: " + *c.loops + "\n");
   if (o.run.stats && c.eliminated.eliminated)
     std::cerr << "system: " << c.eliminated.eliminated << " algebraic unknowns that their equations define "
               << "explicitly are solved out and computed with the results (qdot equations shows them)\n";

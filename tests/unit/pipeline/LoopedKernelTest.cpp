@@ -421,6 +421,33 @@ end ChainEq;
 )");
 }
 
+// `qdot run --stats` says whether the repeated structure became loops and, if not, why: what a
+// user with a large model that runs slowly needs to know.
+TEST(LoopedKernels, TheCompilationSaysWhyItsLoopsWereExpanded) {
+  auto loops = [](const std::string& text, bool keep = true) {
+    Compiled c(text, keep);
+    return c.c.loops;
+  };
+  EXPECT_EQ(loops(kChainThroughDefinitions), std::optional<std::string>(""));
+  EXPECT_EQ(loops(kEnergiesInLoops), std::optional<std::string>(""));
+  EXPECT_EQ(loops(R"(model Pendulum
+  parameter Real m = 1, l = 1, g = 9.81;
+  coordinate Real th(start = 0.5);
+mechanics
+  kinetic = 0.5*m*l^2*der(th)^2;
+  potential = -m*g*l*cos(th);
+end Pendulum;
+)"), std::nullopt);
+  EXPECT_NE(loops(kChainThroughDefinitions, false).value_or("").find("loops are off"), std::string::npos);
+  std::string constrained = kChainThroughDefinitions;
+  constrained.replace(constrained.find("end Written;"), 0, "  constraint x[1] = 0.01;\n");
+  EXPECT_NE(loops(constrained).value_or("").find("it has a constraint (model.qd:14)"), std::string::npos) << *loops(constrained);
+  std::string implicit = kChainWithDefinitions;
+  implicit.replace(implicit.find("tension = k*"), 12, "tension^3 = k*");
+  EXPECT_NE(loops(implicit, true).value_or("").find("the equation at model.qd:13 does not define"), std::string::npos)
+      << loops(implicit).value_or("(none)");
+}
+
 TEST(LoopedKernels, SpringChainGivesTheScalarResidualAndJacobian) {
   size_t loops = expectSameKernels(R"(model Chain
   parameter Integer n = 9;
