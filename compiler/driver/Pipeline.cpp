@@ -120,7 +120,6 @@ std::string whyScalar(const flat::FlatModel& m, const CompileOptions& o, const s
   if (!o.keepLoops) return "loops are off (--no-loops, or a command that works on scalars)";
   if (!m.constraints.empty())
     return "it has a constraint (" + flat::lineOf(sm, m.constraints[0].origin.range) + "): index reduction works on scalars";
-  if (m.components.size() > 1) return "it has components (" + m.components[1] + ", …): arrays of components are expanded";
   if (!defined && failing < m.equations.size())
     return "the equation at " + flat::lineOf(sm, m.equations[failing].origin.range) +
            " does not define an algebraic unknown of its own over coordinates, velocities, parameters and time";

@@ -448,6 +448,19 @@ end Pendulum;
       << loops(implicit).value_or("(none)");
 }
 
+// A component whose energies are sums (the Vibration library's String) in a model that connects
+// nothing: no aliases, no flows, so its sums are loops as the model's own would be.
+TEST(LoopedKernels, AComponentWithSumsAndNoConnectionsKeepsItsLoops) {
+  const std::string text = R"(model Strung
+  import Vibration.*;
+  String str(n = 15, T = 100, rhoL = 0.01, L = 1, y(start = {0.001*sin(pi*i/16) for i in 1:15}));
+end Strung;
+)";
+  EXPECT_EQ(expectSameKernels(text), 2u);
+  Compiled c(text, true);
+  EXPECT_EQ(c.c.loops, std::optional<std::string>(""));
+}
+
 TEST(LoopedKernels, SpringChainGivesTheScalarResidualAndJacobian) {
   size_t loops = expectSameKernels(R"(model Chain
   parameter Integer n = 9;
