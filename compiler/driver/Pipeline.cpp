@@ -72,7 +72,11 @@ bool check(Compilation& c) {
 // (flat::loopableParameters; in several dimensions of the shape of the coordinates the template
 // reads). `shape`: the coordinates' shape if known (a force's target), else null.
 bool loopsRead(const flat::FlatModel& m, sym::Expr body, size_t rank, const std::vector<int>*& shape,
-               const sym::Context& ctx) {
+               const sym::Context& ctx, std::string* unread = nullptr) {
+  auto refuse = [&](const flat::ArrayVariable& a, const char* why) {
+    if (unread) *unread = "'" + a.name + "' (" + why + ")";
+    return false;
+  };
   std::vector<const flat::RelativeElement*> parameters;
   for (sym::Expr s : ctx.freeSymbols(body)) {
     const flat::RelativeElement* rel = m.relativeElement(s);
@@ -81,15 +85,19 @@ bool loopsRead(const flat::FlatModel& m, sym::Expr body, size_t rank, const std:
     int var = m.variableOf(a.elements[0]);
     flat::VarRole role = var >= 0 ? m.variables[var].role : flat::VarRole::Parameter;
     if (var >= 0 && (role == flat::VarRole::Coordinate || role == flat::VarRole::Velocity)) {
-      if (shape && *shape != a.shape) return false;
+      if (shape && *shape != a.shape) return refuse(a, "coordinates of another shape than the others the loop reads");
       shape = &a.shape;
     } else {
       parameters.push_back(rel);
     }
   }
-  return std::all_of(parameters.begin(), parameters.end(), [&](const flat::RelativeElement* rel) {
-    return shape && flat::loopableParameters(m, *rel, rank, *shape);
-  });
+  for (const flat::RelativeElement* rel : parameters) {
+    const flat::ArrayVariable& a = m.patterns->arrays[rel->array];
+    if (m.variableOf(a.elements[0]) < 0) return refuse(a, "its elements are expressions, not variables");
+    if (!shape || !flat::loopableParameters(m, *rel, rank, *shape))
+      return refuse(a, "parameters a loop reads only in the coordinates' shape, subscripted by the iterators in order");
+  }
+  return true;
 }
 
 bool loopsReadForce(const flat::FlatModel& m, const flat::IndexedForce& f, const sym::Context& ctx) {
@@ -133,14 +141,17 @@ std::string whyScalar(const flat::FlatModel& m, const CompileOptions& o, const s
     if (var.role == flat::VarRole::Derivative) return "'" + std::string(var.name) + "' is the rate of an unknown that is not a coordinate";
     if (var.role == flat::VarRole::Unknown && !isDefined[v]) return "'" + std::string(var.name) + "' is an unknown no equation defines explicitly";
   }
+  std::string unread;
   for (const auto& sum : m.indexedSums) {
     const std::vector<int>* shape = nullptr;
-    if (!loopsRead(m, sum.body, sum.box.size(), shape, ctx))
-      return "the sum at " + flat::lineOf(sm, sum.range) + " reads an array a loop cannot address (arrays of parameters must " +
-             "be of the coordinates' shape, indexed by the iterators in order)";
+    if (!loopsRead(m, sum.body, sum.box.size(), shape, ctx, &unread))
+      return "the sum at " + flat::lineOf(sm, sum.range) + " reads " + unread;
   }
-  for (const auto& f : m.indexedForces)
-    if (!loopsReadForce(m, f, ctx)) return "the force at " + flat::lineOf(sm, f.range) + " reads an array a loop cannot address";
+  for (const auto& f : m.indexedForces) {
+    const std::vector<int>* shape = &m.patterns->arrays[m.relativeElement(f.target)->array].shape;
+    if (!loopsRead(m, f.body, f.box.size(), shape, ctx, &unread))
+      return "the force at " + flat::lineOf(sm, f.range) + " reads " + unread;
+  }
   return "";
 }
 
