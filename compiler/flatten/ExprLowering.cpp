@@ -79,8 +79,10 @@ Value Flattener::lower(const ast::Expr& e) {
 Value Flattener::lowerName(const NameExpr& n) {
   if (n.parts.size() > 1) return frames_.empty() ? lowerDotted(n) : lowerFunctionName(n);
   const std::string& name = n.parts[0];
-  for (size_t k = 0; k < templateIterators_.size(); ++k)  // a template's iterator as a number
-    if (templateIterators_[k].name == name) return Value::scalar(out_.patterns->iteratorSymbol(ctx_, static_cast<int>(k)));
+  for (size_t k = templateIterators_.size(); k-- > 0;)  // a template's iterator as a number (innermost first)
+    if (const TemplateIterator& it = templateIterators_[k]; it.name == name)
+      return Value::scalar(it.alias < 0 ? out_.patterns->iteratorSymbol(ctx_, static_cast<int>(k))
+                                        : ctx_.add(out_.patterns->iteratorSymbol(ctx_, it.alias), ctx_.constant(static_cast<double>(it.shift))));
   for (auto it = iterators_.rbegin(); it != iterators_.rend(); ++it)
     if (it->first == name) return Value::scalar(it->second);
   if (!frames_.empty()) return lowerFunctionName(n);

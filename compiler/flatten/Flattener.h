@@ -167,6 +167,11 @@ struct AliasEquation {
 struct TemplateIterator {
   std::string name;
   long first = 0, last = 0;
+  /// The iterator of an array definition's comprehension read inside a template (`px[i+1]` with
+  /// `Real px[n] = {l*sin(th[j]) for j in 1:n}`): the name stands for template iterator `alias`
+  /// plus `shift` (-1: a template iterator of its own, which the template's box has).
+  int alias = -1;
+  long shift = 0;
 };
 
 /// A top-level summand of an energy statement or an output, its sign, and the factors it is
@@ -319,6 +324,8 @@ class Flattener {
   /// of the definition resolves it as usual, and its output then takes the expanded value.
   std::map<const Instance::Slot*, size_t> keptOutputs_;
   std::optional<Value> lowerRelativeIndex(const ast::IndexExpr& e);
+  const ast::ComprehensionExpr* elementwiseDefinition(const ast::IndexExpr& e);
+  std::optional<Value> lowerDefinitionElement(const ast::IndexExpr& e, const ast::ComprehensionExpr& binding);
   sym::Expr relativeSymbol(const RelativeElement& rel);
   int arrayOf(const Value& declared, const std::string& name);
   long plainInteger(const ast::Expr& e);

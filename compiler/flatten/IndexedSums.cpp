@@ -73,9 +73,9 @@ class TemplateCheck {
     return -1;
   }
 
-  int iteratorIndex(const NameExpr& n) const {
+  int iteratorIndex(const NameExpr& n) const {  // innermost first (a definition's own iterator may shadow one)
     if (n.parts.size() != 1) return -1;
-    for (size_t k = 0; k < its_.size(); ++k)
+    for (size_t k = its_.size(); k-- > 0;)
       if (its_[k].name == n.parts[0]) return static_cast<int>(k);
     return -1;
   }
@@ -726,6 +726,7 @@ std::optional<IndexedForce> Flattener::lowerForceTemplate(const MechanicsStmt& s
 // subscripts, an ordinary subscript).
 std::optional<Value> Flattener::lowerRelativeIndex(const IndexExpr& e) {
   if (!mentions(&e, templateIterators_)) return std::nullopt;
+  if (const ComprehensionExpr* binding = elementwiseDefinition(e)) return lowerDefinitionElement(e, *binding);
   Value holder;
   const Value& base = subscriptBase(*e.base, holder);
   if (&base == &holder || e.subscripts.size() != base.shape.size()) throw NotATemplate{};
@@ -742,6 +743,7 @@ std::optional<Value> Flattener::lowerRelativeIndex(const IndexExpr& e) {
       offset = plainInteger(*offsetExpr);
       if (negative) offset = -offset;
     }
+    if (k >= 0 && templateIterators_[k].alias >= 0) offset += templateIterators_[k].shift, k = templateIterators_[k].alias;
     long lo = k < 0 ? offset : templateIterators_[k].first + offset;
     long hi = k < 0 ? offset : templateIterators_[k].last + offset;
     if (lo < 1 || hi > base.shape[d]) throw NotATemplate{};  // the scalar lowering reports it
@@ -749,6 +751,56 @@ std::optional<Value> Flattener::lowerRelativeIndex(const IndexExpr& e) {
   }
   rel.array = arrayOf(base, cast<NameExpr>(e.base.get())->parts[0]);
   return Value::scalar(relativeSymbol(rel));
+}
+
+// `px[i + o]` where px is a one-dimensional definition of this instance bound (unmodified) to a
+// comprehension `{body for j in a:b}`: that comprehension, else nullptr.
+const ComprehensionExpr* Flattener::elementwiseDefinition(const IndexExpr& e) {
+  auto* name = dyn_cast<NameExpr>(e.base.get());
+  if (!name || name->parts.size() != 1 || e.subscripts.size() != 1 || !iterators_.empty() ||
+      TemplateCheck(templateIterators_).iteratorIndex(*name) >= 0)
+    return nullptr;
+  const sema::ModelSymbol* s = cur_->cls->find(name->parts[0]);
+  if (!s || s->kind != sema::SymbolKind::Definition || !s->decl->binding || s->decl->typeDims.size() + s->decl->dims.size() != 1 ||
+      modifierOf(*cur_, *s->decl))
+    return nullptr;
+  auto* c = dyn_cast<ComprehensionExpr>(s->decl->binding.get());
+  auto* range = c && c->iterators.size() == 1 ? dyn_cast<RangeExpr>(c->iterators[0].range.get()) : nullptr;
+  return range && range->start && range->stop && !range->step ? c : nullptr;
+}
+
+// The element of such a definition at the template's point: its comprehension's body with j the
+// template iterator plus the subscript's offset (shifted by the range's start), lowered as part of
+// the template — so a sum over `px[i]` reads the coordinates px is made of, as if written out.
+// Where that is not a template (a constant subscript, a range out of bounds, a body TemplateCheck
+// refuses), the element is lowered as usual (nullopt) or the template is refused (NotATemplate).
+std::optional<Value> Flattener::lowerDefinitionElement(const IndexExpr& e, const ComprehensionExpr& binding) {
+  const ast::Expr* offsetExpr;
+  bool negative;
+  TemplateCheck check(templateIterators_);
+  int k = check.subscriptIterator(*e.subscripts[0], offsetExpr, negative);
+  if (k < 0) throw NotATemplate{};
+  long offset = offsetExpr ? (negative ? -plainInteger(*offsetExpr) : plainInteger(*offsetExpr)) : 0;
+  if (templateIterators_[k].alias >= 0) offset += templateIterators_[k].shift, k = templateIterators_[k].alias;
+  const ast::Iterator& j = binding.iterators[0];
+  const auto& range = *cast<RangeExpr>(j.range.get());
+  // (names of the binding are the definition's: none may be taken for a template's iterator)
+  std::vector<TemplateIterator> outer;  // those the binding's own iterator does not shadow
+  for (const TemplateIterator& it : templateIterators_)
+    if (it.name != j.name) outer.push_back(it);
+  if (mentions(range.start.get(), templateIterators_) || mentions(range.stop.get(), templateIterators_) ||
+      mentions(binding.body.get(), outer))
+    throw NotATemplate{};
+  long a = plainInteger(*range.start), b = plainInteger(*range.stop);
+  if (templateIterators_[k].first + offset < 1 || templateIterators_[k].last + offset > b - a + 1) throw NotATemplate{};
+  templateIterators_.push_back({j.name, templateIterators_[k].first + offset + a - 1, templateIterators_[k].last + offset + a - 1,
+                                k, offset + a - 1});
+  struct Pop {
+    std::vector<TemplateIterator>& its;
+    ~Pop() { its.pop_back(); }
+  } pop{templateIterators_};
+  if (!TemplateCheck(templateIterators_).body(*binding.body)) throw NotATemplate{};
+  return Value::scalar(lowerScalar(*binding.body, "an element of a definition"));
 }
 
 // A subscript's constant part as an integer; anything else (a range, `end`, 1.5) is the scalar

@@ -461,6 +461,27 @@ end Strung;
   EXPECT_EQ(c.c.loops, std::optional<std::string>(""));
 }
 
+// Positions stated as array definitions (`Real px[n] = {l*sin(th[i]) for i in 1:n}`, as the spec
+// lets a model state positions) read inside sums: each element is the comprehension's body at the
+// template's point, so the coupled pendulums' energies are loops over the angles. The definition's
+// iterator may have the sum's name (it shadows it) or another, and an offset range (2:n+1).
+TEST(LoopedKernels, ArrayDefinitionsReadInSumsAreTheirBodies) {
+  const std::string text = R"(model CoupledPendulums
+  parameter Integer n = 9;
+  parameter Real m = 1, l = 1, g = 9.81, k = 50;
+  coordinate Real th[n](start = {0.1*sin(3.14159*i/(n + 1)) for i in 1:n});
+  Real px[n] = {l*sin(th[i]) for i in 1:n};
+  Real py[n] = {-l*cos(th[j - 1]) for j in 2:n + 1};
+mechanics
+  kinetic = sum(0.5*m*(der(px[i])^2 + der(py[i])^2) for i in 1:n);
+  potential = sum(m*g*py[i] for i in 1:n) + sum(0.5*k*(px[i+1] - px[i])^2 for i in 1:n-1);
+end CoupledPendulums;
+)";
+  EXPECT_GE(expectSameKernels(text), 2u);
+  Compiled c(text, true);
+  EXPECT_EQ(c.c.loops, std::optional<std::string>(""));
+}
+
 TEST(LoopedKernels, SpringChainGivesTheScalarResidualAndJacobian) {
   size_t loops = expectSameKernels(R"(model Chain
   parameter Integer n = 9;
