@@ -328,18 +328,27 @@ bool Flattener::readsOnlyCoordinatesAndData(const ast::Expr& e, std::vector<std:
   }
 }
 
-// A scalar definition (not an output) whose binding has sums as summands and reads only
-// coordinates and data (readsOnlyCoordinatesAndData): with templates, an energy statement or an
-// output that names it lowers its binding summand by summand (collectSummands), so resolving it
-// at its declaration would only expand its sums for nothing. It waits (deferred_): still unused
+// A scalar definition (not an output) whose binding has sums as summands, or an array bound to a
+// comprehension, that reads only coordinates and data (readsOnlyCoordinatesAndData): with
+// templates, an energy statement or an output that names it lowers its binding summand by summand
+// (collectSummands), a sum that reads an element lowers that element (lowerDefinitionElement), so
+// resolving it at its declaration would only expand it for nothing. It waits (deferred_): still unused
 // after everything else, it is resolved then (for its diagnostics), unless a statement inlined it.
 bool Flattener::defersDefinition(Instance& inst, const sema::ModelSymbol& s) {
   const ast::Declaration& d = *s.decl;
-  if (s.kind != sema::SymbolKind::Definition || d.causality == Causality::Output || !d.binding ||
-      !d.typeDims.empty() || !d.dims.empty() || modifierOf(inst, d))
+  if (s.kind != sema::SymbolKind::Definition || d.causality == Causality::Output || !d.binding || modifierOf(inst, d))
     return false;
   std::vector<std::string> its;
   if (!readsOnlyCoordinatesAndData(*d.binding, its, s.index)) return false;
+  // An array bound to a comprehension, which templates read element by element (lowerDefinitionElement).
+  if (d.typeDims.size() + d.dims.size() == 1) {
+    auto* c = dyn_cast<ComprehensionExpr>(d.binding.get());
+    auto* range = c && c->iterators.size() == 1 ? dyn_cast<RangeExpr>(c->iterators[0].range.get()) : nullptr;
+    if (!range || !range->start || !range->stop || range->step) return false;
+    deferred_.push_back({&inst, &s});
+    return true;
+  }
+  if (!d.typeDims.empty() || !d.dims.empty()) return false;
   std::vector<Summand> summands;  // (no definition to go through: it reads none)
   collectSummands(*d.binding, summands, &d);
   if (std::none_of(summands.begin(), summands.end(), [](const Summand& t) { return sumCall(*t.expr) != nullptr; }))
@@ -800,7 +809,9 @@ std::optional<Value> Flattener::lowerDefinitionElement(const IndexExpr& e, const
     ~Pop() { its.pop_back(); }
   } pop{templateIterators_};
   if (!TemplateCheck(templateIterators_).body(*binding.body)) throw NotATemplate{};
-  return Value::scalar(lowerScalar(*binding.body, "an element of a definition"));
+  Value element = Value::scalar(lowerScalar(*binding.body, "an element of a definition"));
+  inlined_.insert(&cur_->slots[cur_->cls->find(cast<NameExpr>(e.base.get())->parts[0])->index]);
+  return element;
 }
 
 // A subscript's constant part as an integer; anything else (a range, `end`, 1.5) is the scalar

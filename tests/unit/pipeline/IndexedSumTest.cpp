@@ -434,6 +434,32 @@ end Bad;
   }
 }
 
+// The same for an array definition a sum reads element by element (deferred, as it reads only
+// coordinates and data): an element out of range is reported once, used or not.
+TEST(IndexedSum, ArrayDefinitionsReportTheirErrorsOnce) {
+  for (bool used : {true, false}) {
+    std::string text = R"(model Bad
+  parameter Integer n = 6;
+  parameter Real m = 1, l = 1;
+  coordinate Real th[n](start = {0.01*i for i in 1:n});
+  Real px[n] = {l*sin(th[i + 1]) for i in 1:n};
+mechanics
+  kinetic = )" + std::string(used ? "sum(0.5*m*der(px[i])^2 for i in 1:n)" : "sum(0.5*m*der(th[i])^2 for i in 1:n)") + R"(;
+end Bad;
+)";
+    test::SourceDae s("bad.qd", text, driver::Stage::Check);
+    flat::FlattenLimits keep;
+    keep.keepLoops = true;
+    EXPECT_FALSE(flat::flatten(*s.compilation.checked, s.ctx, s.diags, keep));
+    std::ostringstream rendered;
+    s.diags.render(rendered, s.sources);
+    std::string out = rendered.str();
+    size_t first = out.find("error[E0301]");
+    EXPECT_NE(first, std::string::npos) << out;
+    EXPECT_EQ(out.find("error[E0301]", first + 1), std::string::npos) << "reported twice:\n" << out;
+  }
+}
+
 TEST(TemplateRows, ChainInteriorIsOneTemplateAndEqualsTheScalarRows) {
   std::string chain = kChain;
   auto rows = expectRowsMatchScalarDerivation("chain.qd", chain.c_str());

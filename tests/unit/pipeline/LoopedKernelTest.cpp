@@ -480,6 +480,10 @@ end CoupledPendulums;
   EXPECT_GE(expectSameKernels(text), 2u);
   Compiled c(text, true);
   EXPECT_EQ(c.c.loops, std::optional<std::string>(""));
+  // Where the templates do not apply, exactly the scalar lowering (the definitions resolved whole).
+  std::string scalar = text;
+  scalar.replace(scalar.find("mechanics"), 9, "  Real y(start = 1);\nequation\n  der(y) = -y;\nmechanics");
+  test::expectScalarFallback(scalar);
 }
 
 TEST(LoopedKernels, SpringChainGivesTheScalarResidualAndJacobian) {
