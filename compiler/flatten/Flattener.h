@@ -318,6 +318,8 @@ class Flattener {
   std::vector<DeclKey> deferred_;                    ///< definitions waiting to be inlined (defersDefinition)
   std::set<const Instance::Slot*> inlined_;          ///< definitions whose bindings statements inlined
   bool lowerIndexedSum(const ast::CallExpr& call, bool negated, IndexedSum& sum);
+  std::optional<sym::Expr> lowerTemplated(const ast::Expr& e, const std::vector<TemplateIterator>& its, const char* what,
+                                          bool unknownRates = false);
   bool lowerOutputKeepingSums(Instance& inst, const sema::ModelSymbol& s);
   bool lowerEquationKeepingSums(const ast::Equation& eq, std::vector<Equation>& into);
   /// The outputs lowered with their sums kept (lowerOutputKeepingSums), by declaration: a later use

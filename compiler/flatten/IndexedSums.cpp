@@ -477,6 +477,24 @@ bool Flattener::addTemplateIterator(const ast::Iterator& it, std::vector<Templat
   return true;
 }
 
+// e lowered with `its` as the template's iterators (relative symbols for their subscripts), or
+// nullopt where it is no template (NotATemplate: the scalar lowering takes over); the iterators are
+// cleared on every way out. `unknownRates`: der() of an array of unknowns is an array (for equations).
+std::optional<Expr> Flattener::lowerTemplated(const ast::Expr& e, const std::vector<TemplateIterator>& its, const char* what,
+                                              bool unknownRates) {
+  templateIterators_ = its;
+  ratesOfUnknowns_ = unknownRates;
+  struct Clear {
+    Flattener& f;
+    ~Clear() { f.templateIterators_.clear(), f.ratesOfUnknowns_ = false; }
+  } clear{*this};
+  try {
+    return lowerScalar(e, what);
+  } catch (NotATemplate&) {
+    return std::nullopt;
+  }
+}
+
 // Lowers the sum as a template; false (nothing reported, nothing recorded) where the scalar
 // lowering must do it.
 bool Flattener::lowerIndexedSum(const CallExpr& call, bool negated, IndexedSum& sum) {
@@ -485,20 +503,11 @@ bool Flattener::lowerIndexedSum(const CallExpr& call, bool negated, IndexedSum& 
   for (const auto& it : comp.iterators)
     if (!addTemplateIterator(it, its)) return false;
   if (!TemplateCheck(its).body(*comp.body)) return false;
-  templateIterators_ = std::move(its);
-  try {
-    sum.body = lowerScalar(*comp.body, "the terms of a sum");
-  } catch (NotATemplate&) {
-    templateIterators_.clear();
-    return false;
-  } catch (...) {
-    templateIterators_.clear();
-    throw;
-  }
-  if (negated) sum.body = ctx_.neg(sum.body);
-  for (const auto& it : templateIterators_) sum.box.push_back({it.first, it.last});
+  std::optional<Expr> body = lowerTemplated(*comp.body, its, "the terms of a sum");
+  if (!body) return false;
+  sum.body = negated ? ctx_.neg(*body) : *body;
+  for (const auto& it : its) sum.box.push_back({it.first, it.last});
   sum.range = call.range;
-  templateIterators_.clear();
   return true;
 }
 
@@ -610,20 +619,10 @@ std::optional<EquationTemplate> Flattener::lowerEquationTemplate(const ast::Equa
   if (!der || (*der && !isOwnDerivative(**der, check, its.size())) || !check.body(*eq.lhs) || !check.body(*eq.rhs))
     return std::nullopt;
   EquationTemplate t;
-  templateIterators_ = its;
-  ratesOfUnknowns_ = true;
-  auto done = [&] { templateIterators_.clear(), ratesOfUnknowns_ = false; };
-  try {
-    t.lhs = lowerScalar(*eq.lhs, "the left side of an equation");
-    t.rhs = lowerScalar(*eq.rhs, "the right side of an equation");
-  } catch (NotATemplate&) {
-    done();
-    return std::nullopt;
-  } catch (...) {
-    done();
-    throw;
-  }
-  done();
+  std::optional<Expr> lhs = lowerTemplated(*eq.lhs, its, "the left side of an equation", true);
+  std::optional<Expr> rhs = lhs ? lowerTemplated(*eq.rhs, its, "the right side of an equation", true) : std::nullopt;
+  if (!rhs) return std::nullopt;
+  t.lhs = *lhs, t.rhs = *rhs;
   for (const auto& it : its) t.box.push_back({it.first, it.last});
   t.origin = {OriginKind::Equation, eq.range, -1, "", cur_->index};
   return t;
@@ -686,17 +685,9 @@ std::optional<IndexedSum> Flattener::lowerEnergyTemplate(const MechanicsStmt& st
   sum.energy = st.kind == MechanicsKind::Kinetic     ? IndexedSum::Energy::Kinetic
                : st.kind == MechanicsKind::Potential ? IndexedSum::Energy::Potential
                                                      : IndexedSum::Energy::Dissipation;
-  templateIterators_ = its;
-  try {
-    sum.body = lowerScalar(*st.value, "an energy");
-  } catch (NotATemplate&) {
-    templateIterators_.clear();
-    return std::nullopt;
-  } catch (...) {
-    templateIterators_.clear();
-    throw;
-  }
-  templateIterators_.clear();
+  std::optional<Expr> body = lowerTemplated(*st.value, its, "an energy");
+  if (!body) return std::nullopt;
+  sum.body = *body;
   for (const auto& it : its) sum.box.push_back({it.first, it.last});
   sum.range = st.range;
   return sum;
@@ -708,18 +699,10 @@ std::optional<IndexedForce> Flattener::lowerForceTemplate(const MechanicsStmt& s
       !check.body(*st.value))
     return std::nullopt;
   IndexedForce f;
-  templateIterators_ = its;
-  try {
-    f.target = lowerScalar(*st.target, "the coordinate of a force");
-    f.body = lowerScalar(*st.value, "a force");
-  } catch (NotATemplate&) {
-    templateIterators_.clear();
-    return std::nullopt;
-  } catch (...) {
-    templateIterators_.clear();
-    throw;
-  }
-  templateIterators_.clear();
+  std::optional<Expr> target = lowerTemplated(*st.target, its, "the coordinate of a force");
+  std::optional<Expr> body = target ? lowerTemplated(*st.value, its, "a force") : std::nullopt;
+  if (!body) return std::nullopt;
+  f.target = *target, f.body = *body;
   const RelativeElement* rel = out_.patterns->find(f.target);
   if (!rel || rel->dims.size() != its.size()) return std::nullopt;
   for (size_t d = 0; d < rel->dims.size(); ++d)

@@ -407,12 +407,27 @@ end Factors;
   }
 }
 
+// Flattened with templates, `text` fails with exactly one error `code`.
+void expectReportedOnce(const std::string& text, const std::string& code) {
+  test::SourceDae s("bad.qd", text, driver::Stage::Check);
+  flat::FlattenLimits keep;
+  keep.keepLoops = true;
+  EXPECT_FALSE(flat::flatten(*s.compilation.checked, s.ctx, s.diags, keep));
+  std::ostringstream rendered;
+  s.diags.render(rendered, s.sources);
+  std::string out = rendered.str();
+  size_t first = out.find("error[" + code + "]");
+  EXPECT_NE(first, std::string::npos) << out;
+  EXPECT_EQ(out.find("error[" + code + "]", first + 1), std::string::npos) << "reported twice:\n" << out;
+}
+
 // A definition that only a statement inlines is not resolved on its own (its sums would be
 // expanded for nothing), but its errors are reported once, there; one nothing uses is resolved
-// at the end, and its errors reported as before.
+// at the end, and its errors reported as before. The same for an array definition a sum reads
+// element by element.
 TEST(IndexedSum, InlinedAndUnusedDefinitionsReportTheirErrorsOnce) {
   for (bool used : {true, false}) {
-    std::string text = R"(model Bad
+    expectReportedOnce(R"(model Bad
   parameter Integer n = 6;
   parameter Real m = 1;
   coordinate Real x[n](start = {0.01*i for i in 1:n});
@@ -420,25 +435,8 @@ TEST(IndexedSum, InlinedAndUnusedDefinitionsReportTheirErrorsOnce) {
 mechanics
   kinetic = )" + std::string(used ? "T" : "sum(0.5*m*der(x[i])^2 for i in 1:n)") + R"(;
 end Bad;
-)";
-    test::SourceDae s("bad.qd", text, driver::Stage::Check);
-    flat::FlattenLimits keep;
-    keep.keepLoops = true;
-    EXPECT_FALSE(flat::flatten(*s.compilation.checked, s.ctx, s.diags, keep));
-    std::ostringstream rendered;
-    s.diags.render(rendered, s.sources);
-    std::string text2 = rendered.str();
-    size_t first = text2.find("error[E0301]");
-    EXPECT_NE(first, std::string::npos) << text2;
-    EXPECT_EQ(text2.find("error[E0301]", first + 1), std::string::npos) << "reported twice:\n" << text2;
-  }
-}
-
-// The same for an array definition a sum reads element by element (deferred, as it reads only
-// coordinates and data): an element out of range is reported once, used or not.
-TEST(IndexedSum, ArrayDefinitionsReportTheirErrorsOnce) {
-  for (bool used : {true, false}) {
-    std::string text = R"(model Bad
+)", "E0301");
+    expectReportedOnce(R"(model Bad
   parameter Integer n = 6;
   parameter Real m = 1, l = 1;
   coordinate Real th[n](start = {0.01*i for i in 1:n});
@@ -446,17 +444,7 @@ TEST(IndexedSum, ArrayDefinitionsReportTheirErrorsOnce) {
 mechanics
   kinetic = )" + std::string(used ? "sum(0.5*m*der(px[i])^2 for i in 1:n)" : "sum(0.5*m*der(th[i])^2 for i in 1:n)") + R"(;
 end Bad;
-)";
-    test::SourceDae s("bad.qd", text, driver::Stage::Check);
-    flat::FlattenLimits keep;
-    keep.keepLoops = true;
-    EXPECT_FALSE(flat::flatten(*s.compilation.checked, s.ctx, s.diags, keep));
-    std::ostringstream rendered;
-    s.diags.render(rendered, s.sources);
-    std::string out = rendered.str();
-    size_t first = out.find("error[E0301]");
-    EXPECT_NE(first, std::string::npos) << out;
-    EXPECT_EQ(out.find("error[E0301]", first + 1), std::string::npos) << "reported twice:\n" << out;
+)", "E0301");
   }
 }
 

@@ -57,6 +57,23 @@ void expectSameInvariants(const std::string& text, size_t sums) {
   EXPECT_EQ(test::opCount(b.program(ModelProgram::Invariants), kernel::Op::StoreAdd), sums);
 }
 
+// One pendulum: nothing repeated.
+constexpr const char* kPendulum = R"(model Pendulum
+  parameter Real m = 1, l = 1, g = 9.81;
+  coordinate Real th(start = 0.5);
+mechanics
+  kinetic = 0.5*m*l^2*der(th)^2;
+  potential = -m*g*l*cos(th);
+end Pendulum;
+)";
+
+// The model with an equation of its own next to the mechanics (`der(y) = -y`): one whose
+// templates do not apply, so that the fallback to scalars is what gets compiled.
+std::string withAnEquation(std::string text) {
+  text.replace(text.find("mechanics"), 9, "  Real y(start = 1);\nequation\n  der(y) = -y;\nmechanics");
+  return text;
+}
+
 TEST(LoopedKernels, JacobiIntegralOfAChainIsTheScalarOneWithItsSumsAsLoops) {
   expectSameInvariants(R"(model Chain
   parameter Integer n = 9;
@@ -209,9 +226,7 @@ TEST(LoopedKernels, IteratorsAsNumbersGiveTheScalarResidualJacobianAndInvariants
 // Where the templates do not apply (here: an equation section), a model whose templates read an
 // iterator as a number is flattened again without them: the very kernels of the scalar lowering.
 TEST(LoopedKernels, IteratorsAsNumbersFallBackToTheScalarLoweringExactly) {
-  std::string text = kGradedChain;
-  text.replace(text.find("mechanics"), 9, "  Real y(start = 1);\nequation\n  der(y) = -y;\nmechanics");
-  test::expectScalarFallback(text);
+  test::expectScalarFallback(withAnEquation(kGradedChain));
 }
 
 // Equations that define algebraic unknowns explicitly (a link's tension, a push that a force
@@ -330,9 +345,7 @@ TEST(LoopedKernels, EnergiesThroughDefinitionsAndFactorsKeepTheLoops) {
 // where the templates do not apply (here: an equation of an unknown), the model is flattened again
 // and compiles exactly as without templates.
 TEST(LoopedKernels, FactoredSumsFallBackToTheScalarLoweringExactly) {
-  std::string text = kChainThroughDefinitions;
-  text.replace(text.find("mechanics"), 9, "  Real y(start = 1);\nequation\n  der(y) = -y;\nmechanics");
-  test::expectScalarFallback(text);
+  test::expectScalarFallback(withAnEquation(kChainThroughDefinitions));
 }
 
 // Energies stated in `for` loops (`for i in 2:n loop potential = …; end for;`), next to a force
@@ -363,9 +376,7 @@ end Looped;
 
 TEST(LoopedKernels, EnergiesInForLoopsAreSumsWithTheScalarKernels) {
   EXPECT_GE(expectSameKernels(kEnergiesInLoops), 3u);
-  std::string text = kEnergiesInLoops;
-  text.replace(text.find("mechanics"), 9, "  Real y(start = 1);\nequation\n  der(y) = -y;\nmechanics");
-  test::expectScalarFallback(text);
+  test::expectScalarFallback(withAnEquation(kEnergiesInLoops));
 }
 
 // `Real E; equation E = sum(…) + …;` next to the energies: E is defined explicitly, so it becomes an
@@ -430,14 +441,7 @@ TEST(LoopedKernels, TheCompilationSaysWhyItsLoopsWereExpanded) {
   };
   EXPECT_EQ(loops(kChainThroughDefinitions), std::optional<std::string>(""));
   EXPECT_EQ(loops(kEnergiesInLoops), std::optional<std::string>(""));
-  EXPECT_EQ(loops(R"(model Pendulum
-  parameter Real m = 1, l = 1, g = 9.81;
-  coordinate Real th(start = 0.5);
-mechanics
-  kinetic = 0.5*m*l^2*der(th)^2;
-  potential = -m*g*l*cos(th);
-end Pendulum;
-)"), std::nullopt);
+  EXPECT_EQ(loops(kPendulum), std::nullopt);
   EXPECT_NE(loops(kChainThroughDefinitions, false).value_or("").find("loops are off"), std::string::npos);
   std::string constrained = kChainThroughDefinitions;
   constrained.replace(constrained.find("end Written;"), 0, "  constraint x[1] = 0.01;\n");
@@ -481,9 +485,7 @@ end CoupledPendulums;
   Compiled c(text, true);
   EXPECT_EQ(c.c.loops, std::optional<std::string>(""));
   // Where the templates do not apply, exactly the scalar lowering (the definitions resolved whole).
-  std::string scalar = text;
-  scalar.replace(scalar.find("mechanics"), 9, "  Real y(start = 1);\nequation\n  der(y) = -y;\nmechanics");
-  test::expectScalarFallback(scalar);
+  test::expectScalarFallback(withAnEquation(text));
 }
 
 TEST(LoopedKernels, SpringChainGivesTheScalarResidualAndJacobian) {
@@ -674,14 +676,7 @@ end Grid;
 }
 
 TEST(LoopedKernels, PendulumWithoutRepeatedStructureHasNoLoops) {
-  EXPECT_EQ(expectSameKernels(R"(model Pendulum
-  parameter Real m = 1, l = 1, g = 9.81;
-  coordinate Real th(start = 0.5);
-mechanics
-  kinetic = 0.5*m*l^2*der(th)^2;
-  potential = -m*g*l*cos(th);
-end Pendulum;
-)"), 0u);
+  EXPECT_EQ(expectSameKernels(kPendulum), 0u);
 }
 
 }  // namespace
