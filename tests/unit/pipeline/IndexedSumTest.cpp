@@ -344,16 +344,22 @@ TEST(IndexedSum, AnOutputReadElsewhereIsExpandedAsTheScalarLoweringDoes) {
   }
 }
 
-TEST(IndexedSum, AnOutputSumReadingItselfIsTheUsualCycleError) {
-  std::string text = kChainWithEnergyOutputs;
-  text.replace(text.find("- c*der(x[1])^2;"), 16, "- c*der(x[1])^2 + P;");
-  test::SourceDae s("cycle.qd", text, driver::Stage::Check);
+// `text` flattened with templates (FlattenLimits::keepLoops), which must fail: its diagnostics.
+std::string diagnosticsFlatteningWithTemplates(const std::string& text) {
+  test::SourceDae s("bad.qd", text, driver::Stage::Check);
   flat::FlattenLimits keep;
   keep.keepLoops = true;
   EXPECT_FALSE(flat::flatten(*s.compilation.checked, s.ctx, s.diags, keep));
   std::ostringstream rendered;
   s.diags.render(rendered, s.sources);
-  EXPECT_NE(rendered.str().find("error[E0312]: the definition of 'P' depends on itself"), std::string::npos) << rendered.str();
+  return rendered.str();
+}
+
+TEST(IndexedSum, AnOutputSumReadingItselfIsTheUsualCycleError) {
+  std::string text = kChainWithEnergyOutputs;
+  text.replace(text.find("- c*der(x[1])^2;"), 16, "- c*der(x[1])^2 + P;");
+  std::string out = diagnosticsFlatteningWithTemplates(text);
+  EXPECT_NE(out.find("error[E0312]: the definition of 'P' depends on itself"), std::string::npos) << out;
 }
 
 // `kinetic = T` with `Real T = sum(…)`: the definition's binding is the statement's (definitions are
@@ -409,13 +415,7 @@ end Factors;
 
 // Flattened with templates, `text` fails with exactly one error `code`.
 void expectReportedOnce(const std::string& text, const std::string& code) {
-  test::SourceDae s("bad.qd", text, driver::Stage::Check);
-  flat::FlattenLimits keep;
-  keep.keepLoops = true;
-  EXPECT_FALSE(flat::flatten(*s.compilation.checked, s.ctx, s.diags, keep));
-  std::ostringstream rendered;
-  s.diags.render(rendered, s.sources);
-  std::string out = rendered.str();
+  std::string out = diagnosticsFlatteningWithTemplates(text);
   size_t first = out.find("error[" + code + "]");
   EXPECT_NE(first, std::string::npos) << out;
   EXPECT_EQ(out.find("error[" + code + "]", first + 1), std::string::npos) << "reported twice:\n" << out;
