@@ -1,5 +1,6 @@
 // Derivation benchmark: wall time from model text to the assembled DAE (parse, check, flatten,
-// Euler–Lagrange, DAE) for the N-link pendulum (dense mass matrix) and the spring chain (sparse),
+// Euler–Lagrange, DAE) for the N-link pendulum (dense mass matrix), the spring chain (sparse) and the
+// coupled pendulums (a squared sine of every angle),
 // across sizes, with the growth exponent between successive sizes. Best of several repetitions.
 // Usage: derive_bench [--quick] [--simplify=none|fast|full]   (run from the repository root, or set
 // QDOT_SOURCE_DIR); --simplify as in qdot (default fast).
@@ -105,5 +106,8 @@ int main(int argc, char** argv) {
             quick ? std::vector<int>{2, 4, 8, 16} : std::vector<int>{2, 4, 8, 16, 32, 64}, 30);
   runSeries("Spring–damper chain, sparse", dir + "examples/vibration/spring_chain.qd",
             quick ? std::vector<int>{10, 100, 1000} : std::vector<int>{10, 100, 1000, 10000, 100000}, 60);
+  runSeries("Coupled pendulums, sin² of every angle (the simplifier's Pythagorean rewrites)",
+            dir + "examples/pendulum/coupled_pendulums.qd",
+            quick ? std::vector<int>{10, 100, 1000} : std::vector<int>{10, 100, 1000, 4000}, 60);
   return 0;
 }

@@ -8,6 +8,7 @@
 #include "symbolic/Simplify.h"
 
 #include <algorithm>
+#include <set>
 #include <unordered_map>
 #include <vector>
 
@@ -271,64 +272,223 @@ struct Simplifier::Impl {
   }
 
   // --- the trigonometric rewrites --------------------------------------------------------------------
-  static size_t polyCost(const Poly& p) {
-    size_t c = 0;
-    for (const auto& t : p.terms) {
-      if (t.coef == 0.0) continue;
-      c += 1 + (std::abs(t.coef) != 1.0);
-      for (const Factor& f : t.mono) c += 1 + (f.exp != 1);
-    }
-    return c;
-  }
-
   // For each argument u of a squared sin/cos (sinh/cosh), the cheapest of: as is, cos² → 1 − sin²,
-  // sin² → 1 − cos² (cosh² → 1 + sinh², sinh² → cosh² − 1). Never raises polyCost.
+  // sin² → 1 − cos² (cosh² → 1 + sinh², sinh² → cosh² − 1). Never raises the cost (termCost summed).
+  // A rewrite touches only the terms with the square and the terms its products fall on, so it is
+  // weighed and made on those (TermList) rather than by building the polynomial again: with n
+  // arguments (n coupled pendulums) that was O(n²) — 88 s at n = 4 000. The terms, their order and
+  // their coefficients (summed in the same order) are those that rebuilding gave.
   Poly pythagorean(Poly p) {
     std::vector<Expr> squared;  // Sin/Cos/Sinh/Cosh atoms with exponent >= 2, by first appearance
     for (const auto& t : p.terms)
       for (const Factor& f : t.mono)
         if (f.exp >= 2 && isCircularOrHyperbolic(f.atom->kind)) squared.push_back(f.atom);
-    std::vector<std::pair<Expr, bool>> done;  // (argument, hyperbolic)
+    if (squared.empty()) return p;
+    TermList list(p);
+    std::set<std::pair<Expr, bool>> done;  // (argument, hyperbolic)
     for (Expr a : squared) {
       bool hyperbolic = a->kind == Kind::Sinh || a->kind == Kind::Cosh;
-      std::pair<Expr, bool> key{a->args[0], hyperbolic};
-      if (std::find(done.begin(), done.end(), key) != done.end()) continue;
-      done.push_back(key);
+      if (!done.insert({a->args[0], hyperbolic}).second) continue;
       Expr u = a->args[0];
       Expr s = ctx.unary(hyperbolic ? Kind::Sinh : Kind::Sin, u), c = ctx.unary(hyperbolic ? Kind::Cosh : Kind::Cos, u);
       // c² = 1 − s² (circular) or 1 + s² (hyperbolic); s² = 1 − c² or c² − 1.
-      Poly viaSin = replaceSquare(p, c, s, 1.0, hyperbolic ? 1.0 : -1.0);
-      Poly viaCos = replaceSquare(p, s, c, hyperbolic ? -1.0 : 1.0, hyperbolic ? 1.0 : -1.0);
-      size_t now = polyCost(p), a1 = polyCost(viaSin), a2 = polyCost(viaCos);
-      if (a1 < now && a1 <= a2) p = std::move(viaSin);
-      else if (a2 < now) p = std::move(viaCos);
+      Rewrite viaSin = weighSquare(list, c, s, 1.0, hyperbolic ? 1.0 : -1.0);
+      Rewrite viaCos = weighSquare(list, s, c, hyperbolic ? -1.0 : 1.0, hyperbolic ? 1.0 : -1.0);
+      size_t now = list.cost, a1 = viaSin.cost, a2 = viaCos.cost;
+      if (a1 < now && a1 <= a2) list.apply(viaSin);
+      else if (a2 < now) list.apply(viaCos);
     }
-    return p;
+    return list.changed ? list.materialize() : std::move(p);
   }
   static bool isCircularOrHyperbolic(Kind k) { return k == Kind::Sin || k == Kind::Cos || k == Kind::Sinh || k == Kind::Cosh; }
+  static size_t termCost(const Mono& m, double coef) {
+    if (coef == 0.0) return 0;
+    size_t c = 1 + (std::abs(coef) != 1.0);
+    for (const Factor& f : m) c += 1 + (f.exp != 1);
+    return c;
+  }
+  static int exponentOf(const Mono& m, Expr atom) {
+    for (const Factor& f : m)
+      if (f.atom == atom) return f.exp;
+    return 0;
+  }
 
-  // p with every from^k (k >= 2) written as from^(k mod 2) · (constant + sign·to²)^(k/2).
-  Poly replaceSquare(const Poly& p, Expr from, Expr to, double constant, double sign) {
+  // One rewrite from^k → from^(k mod 2) · (constant + sign·to²)^(k/2), weighed but not yet made: the
+  // terms it replaces (`affected`, in term order), each monomial its products fall on (`touched`,
+  // by first appearance) with its coefficient after the rewrite, and the polynomial's cost after it.
+  struct Rewrite {
+    struct Touch {
+      Mono mono;
+      uint32_t existing = Poly::kEnd;  ///< the live term with this monomial, if any
+      double coef = 0.0;               ///< after the rewrite
+    };
+    std::vector<uint32_t> affected;
+    std::vector<std::vector<uint32_t>> products;  ///< per affected term: its touches, in its product's order
+    std::vector<Touch> touched;
+    size_t cost = 0;
+  };
+
+  // The polynomial as a doubly linked list in term order. Ranks (with gaps, renumbered when a gap
+  // closes) compare positions; `squares` finds the terms holding an atom squared.
+  struct TermList {
+    explicit TermList(Poly& poly) : p(poly) {
+      size_t n = p.terms.size();
+      prev.resize(n), next.resize(n), rank.resize(n);
+      for (uint32_t i = 0; i < n; ++i) {
+        prev[i] = i == 0 ? Poly::kEnd : i - 1;
+        next[i] = i + 1 == n ? Poly::kEnd : i + 1;
+        rank[i] = uint64_t{i + 1} << kGapBits;
+        cost += termCost(p.terms[i].mono, p.terms[i].coef);
+        enter(i);
+      }
+      head = n == 0 ? Poly::kEnd : 0;
+    }
+    static constexpr int kGapBits = 20;
+    Poly& p;
+    std::vector<uint32_t> prev, next;
+    std::vector<uint64_t> rank;
+    uint32_t head = Poly::kEnd;
+    std::unordered_map<Expr, std::vector<uint32_t>> squares;
+    std::vector<bool> entered;
+    size_t cost = 0;
+    bool changed = false;
+
+    bool live(uint32_t t) const { return p.terms[t].coef != 0.0; }
+    void enter(uint32_t t) {  // into `squares`, once per term (a revived term is already there)
+      if (entered.size() <= t) entered.resize(t + 1, false);
+      if (entered[t]) return;
+      entered[t] = true;
+      for (const Factor& f : p.terms[t].mono)
+        if (f.exp >= 2 && isCircularOrHyperbolic(f.atom->kind)) squares[f.atom].push_back(t);
+    }
+    void unlink(uint32_t t) {
+      (prev[t] == Poly::kEnd ? head : next[prev[t]]) = next[t];
+      if (next[t] != Poly::kEnd) prev[next[t]] = prev[t];
+    }
+    void renumber() {
+      uint64_t r = 0;
+      for (uint32_t t = head; t != Poly::kEnd; t = next[t]) rank[t] = (r += uint64_t{1} << kGapBits);
+    }
+    void insertAfter(uint32_t at, uint32_t t) {
+      auto gap = [&] { return next[at] == Poly::kEnd ? uint64_t{2} << kGapBits : rank[next[at]] - rank[at]; };
+      if (gap() < 2) renumber();
+      rank[t] = rank[at] + gap() / 2;
+      prev[t] = at, next[t] = next[at];
+      if (next[at] != Poly::kEnd) prev[next[at]] = t;
+      next[at] = t;
+    }
+    // Each touched monomial takes its place where it first appeared (an existing term after that
+    // moves up to it), the affected terms leave, and what cancelled to zero goes.
+    void apply(const Rewrite& w) {
+      changed = true;
+      std::vector<bool> placed(w.touched.size(), false);
+      for (size_t i = 0; i < w.affected.size(); ++i) {
+        uint32_t cursor = w.affected[i];
+        for (uint32_t k : w.products[i]) {
+          const Rewrite::Touch& touch = w.touched[k];
+          if (placed[k]) continue;
+          placed[k] = true;
+          if (touch.coef == 0.0) continue;
+          uint32_t t = touch.existing;
+          if (t != Poly::kEnd && rank[t] < rank[w.affected[i]]) continue;  // stays where it is
+          if (t == Poly::kEnd) t = add(touch.mono);
+          else unlink(t);
+          insertAfter(cursor, t);
+          cursor = t;
+        }
+        unlink(w.affected[i]);
+        p.terms[w.affected[i]].coef = 0.0;
+      }
+      for (const Rewrite::Touch& touch : w.touched) {
+        if (touch.existing != Poly::kEnd && touch.coef == 0.0) unlink(touch.existing);
+        Poly::Term* t = p.find(touch.mono);
+        if (t) t->coef = touch.coef;
+      }
+      cost = w.cost;
+    }
+    uint32_t add(const Mono& m) {  // a new term (or a dead one revived) with coefficient 0 for now
+      Poly::Term* t = p.find(m);
+      if (!t) {
+        p.add(m, 1.0);
+        t = p.find(m);
+      }
+      uint32_t id = static_cast<uint32_t>(t - p.terms.data());
+      if (prev.size() <= id) prev.resize(id + 1), next.resize(id + 1), rank.resize(id + 1);
+      enter(id);
+      return id;
+    }
+    Poly materialize() {
+      Poly out;
+      for (uint32_t t = head; t != Poly::kEnd; t = next[t]) out.add(std::move(p.terms[t].mono), p.terms[t].coef);
+      return out;
+    }
+  };
+
+  // Weighs rewriting every from^k (k >= 2) as from^(k mod 2) · (constant + sign·to²)^(k/2): the
+  // products of the affected terms in term order, each product's terms in its order, added to what
+  // is there in the order a rebuild would have added them (an existing term at its own place).
+  Rewrite weighSquare(TermList& list, Expr from, Expr to, double constant, double sign) {
+    Rewrite w;
+    w.cost = list.cost;
+    if (auto it = list.squares.find(from); it != list.squares.end())
+      for (uint32_t t : it->second)
+        if (list.live(t) && exponentOf(list.p.terms[t].mono, from) >= 2) w.affected.push_back(t);
+    if (w.affected.empty()) return w;
+    std::sort(w.affected.begin(), w.affected.end(), [&](uint32_t a, uint32_t b) { return list.rank[a] < list.rank[b]; });
     Poly square;
     square.add({}, constant);
     square.add({{to, 2}}, sign);
-    Poly out;
-    for (const auto& t : p.terms) {
-      auto at = std::find_if(t.mono.begin(), t.mono.end(), [&](const Factor& f) { return f.atom == from; });
-      if (t.coef == 0.0 || at == t.mono.end() || at->exp < 2) {
-        out.add(t.mono, t.coef);
-        continue;
-      }
-      Mono rest = t.mono;
-      rest.erase(rest.begin() + (at - t.mono.begin()));
-      if (at->exp % 2) rest = multiplyMonos(rest, {{from, 1}});
+    struct Part {
+      uint64_t rank;
+      double coef;
+    };
+    std::vector<std::vector<Part>> parts;
+    std::unordered_map<Mono, uint32_t, MonoHash> touchOf;
+    for (uint32_t a : w.affected) {
+      const Poly::Term& t = list.p.terms[a];
+      w.cost -= termCost(t.mono, t.coef);
+      int k = exponentOf(t.mono, from);
+      Mono rest;
+      for (const Factor& f : t.mono)
+        if (f.atom != from) rest.push_back(f);
+      if (k % 2) rest = multiplyMonos(rest, {{from, 1}});
       Poly term;
       term.add(std::move(rest), t.coef);
-      addScaled(out, multiply(term, power(square, at->exp / 2)), 1.0);
+      Poly product = multiply(term, power(square, k / 2));
+      spend(product.terms.size());
+      auto& mine = w.products.emplace_back();
+      for (const auto& r : product.terms) {
+        if (1.0 * r.coef == 0.0) continue;
+        auto [at, fresh] = touchOf.try_emplace(r.mono, static_cast<uint32_t>(w.touched.size()));
+        if (fresh) {
+          w.touched.push_back({r.mono});
+          parts.emplace_back();
+        }
+        parts[at->second].push_back({list.rank[a], 1.0 * r.coef});
+        mine.push_back(at->second);
+      }
     }
-    out.compact();
-    return out;
+    for (size_t k = 0; k < w.touched.size(); ++k) {
+      Rewrite::Touch& touch = w.touched[k];
+      const Poly::Term* old = list.p.find(touch.mono);
+      if (old && old->coef != 0.0) touch.existing = static_cast<uint32_t>(old - list.p.terms.data());
+      uint64_t own = touch.existing == Poly::kEnd ? UINT64_MAX : list.rank[touch.existing];
+      bool first = true, ownAdded = touch.existing == Poly::kEnd;
+      auto addPart = [&](double c) {
+        touch.coef = first ? c : touch.coef + c;
+        first = false;
+      };
+      for (const Part& part : parts[k]) {
+        if (!ownAdded && own < part.rank) addPart(old->coef), ownAdded = true;
+        addPart(part.coef);
+      }
+      if (!ownAdded) addPart(old->coef);
+      if (touch.existing != Poly::kEnd) w.cost -= termCost(old->mono, old->coef);
+      w.cost += termCost(touch.mono, touch.coef);
+    }
+    return w;
   }
+
 
   // sin a cos b ± cos a sin b = sin(a ± b), cos a cos b ∓ sin a sin b = cos(a ± b): pairs of terms
   // with the same rest and coefficients equal up to sign become one term.

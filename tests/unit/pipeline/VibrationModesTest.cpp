@@ -7,7 +7,8 @@
 //   pendulum_absorber (cart M on a spring k carrying a pendulum m, l): M = [[M+m, m l], [m l, m l²]],
 //     K = diag(k, m g l);
 //   damped_vibration: four independent oscillators ω0 = √(k/m), ζ = c/(2√(km)) (ζ = 1, 2 do not oscillate);
-//   free_vibration: ω = √(k/m) and the disk's √(kt/J).
+//   free_vibration: ω = √(k/m) and the disk's √(kt/J);
+//   coupled_pendulums (examples/pendulum): the free–free chain of pendulums, below.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -81,6 +82,23 @@ TEST(VibrationModes, LumpedStringMatchesItsExactModesAndApproachesTheContinuousS
     EXPECT_LT(error, previousError / 4) << "second order in h: the error shrinks with (n+1)²";
     previousError = error;
   }
+}
+
+// examples/pendulum/coupled_pendulums.qd: n pendulums (m, l) with springs k between neighbouring
+// bobs; linearized, M = m l² I and K = m g l I + k l² L (L the free–free Laplacian), so
+// ω_j² = g/l + 4 (k/m) sin²((j − 1) π / (2 n)). Its potential holds sin² of every angle: the scalar
+// derivation goes through the simplifier's Pythagorean rewrites for each of the n arguments.
+TEST(VibrationModes, CoupledPendulumsMatchTheFreeChainsModes) {
+  const int n = 120;
+  const double m = 1, l = 1, g = 9.81, k = 2;
+  ModesResult r = modesOf("pendulum/coupled_pendulums.qd", {"n=" + std::to_string(n)});
+  ASSERT_EQ(r.error, "");
+  ASSERT_EQ(r.modes.size(), static_cast<size_t>(n));
+  for (int j = 1; j <= n; ++j) {
+    double s = std::sin((j - 1) * std::numbers::pi / (2 * n));
+    expectRelative(r.modes[j - 1].omega, std::sqrt(g / l + 4 * (k / m) * s * s));
+  }
+  for (int i = 1; i < n; ++i) expectRelative(r.modes[0].shape[i], r.modes[0].shape[0]);  // all swing together
 }
 
 TEST(VibrationModes, PendulumAbsorberTwoModes) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "RandomTree.h"
 #include "symbolic/Simplify.h"
@@ -191,6 +192,58 @@ TEST(ExpandAngleDifferences, WritesDifferencesThroughEachAngle) {
     EXPECT_NEAR(evaluate(out[i], values), evaluate(roots[i], values), 1e-15) << toString(ctx, roots[i]);
     EXPECT_FALSE(toString(ctx, out[i]).find("a - b") != std::string::npos) << toString(ctx, out[i]);
   }
+}
+
+}  // namespace
+
+namespace {
+
+// Sums of products of squared sines and cosines (and hyperbolic ones) of a few arguments, with
+// coefficients that cancel or nearly cancel: the Pythagorean rewrites move, merge and drop terms
+// (pythagorean rewrites in place); the result has the original's values at random points.
+TEST(SimplifyRandom, TrigonometricSquaresKeepTheirValues) {
+  std::mt19937_64 rng(7);
+  const double coefs[] = {1, -1, 2, 0.5, -0.5, 0.1, 0.2, -0.3, 3};
+  int rewritten = 0;
+  for (int round = 0; round < 3000; ++round) {
+    Context ctx;
+    std::vector<Expr> x{ctx.symbol("x0"), ctx.symbol("x1"), ctx.symbol("x2")};
+    std::vector<Expr> args{x[0], ctx.sub(x[0], x[1]), ctx.add(x[2], x[0])};
+    const Kind kinds[] = {Kind::Sin, Kind::Cos, Kind::Sinh, Kind::Cosh};
+    int terms = 1 + static_cast<int>(rng() % 9);
+    std::vector<Expr> sum;
+    for (int t = 0; t < terms; ++t) {
+      std::vector<Expr> factors{ctx.constant(coefs[rng() % std::size(coefs)])};
+      int n = 1 + static_cast<int>(rng() % 3);
+      for (int f = 0; f < n; ++f) {
+        Kind k = kinds[rng() % (rng() % 4 == 0 ? 4 : 2)];
+        Expr u = args[rng() % args.size()];
+        factors.push_back(ctx.pow(ctx.unary(k, ctx.mul(ctx.constant(0.3), u)), ctx.constant(static_cast<double>(1 + rng() % 4))));
+      }
+      if (rng() % 3 == 0) factors.push_back(x[rng() % 3]);
+      sum.push_back(ctx.mul(std::span<const Expr>(factors)));
+      if (rng() % 2 == 0) {  // its partner: one factor's sine for its cosine (or back), which may cancel
+        size_t f = 1 + rng() % n;
+        bool power = factors[f]->kind == Kind::Pow;
+        Expr base = power ? factors[f]->args[0] : factors[f];
+        Kind partner = base->kind == Kind::Sin ? Kind::Cos : base->kind == Kind::Cos ? Kind::Sin
+                     : base->kind == Kind::Sinh ? Kind::Cosh : Kind::Sinh;
+        factors[f] = ctx.pow(ctx.unary(partner, base->args[0]), power ? factors[f]->args[1] : ctx.one());
+        if (rng() % 2 == 0) factors[0] = ctx.constant(-factors[0]->value);
+        sum.push_back(ctx.mul(std::span<const Expr>(factors)));
+      }
+    }
+    Expr e = ctx.add(std::span<const Expr>(sum));
+    Expr s = simplify(ctx, e, SimplifyLevel::Full);
+    rewritten += s != e;
+    for (int p = 0; p < 3; ++p) {
+      std::uniform_real_distribution<double> d(-2, 2);
+      std::vector<double> at{d(rng), d(rng), d(rng)};
+      double v0 = evaluate(e, at), v1 = evaluate(s, at);
+      ASSERT_NEAR(v1, v0, 1e-9 * std::max(1.0, std::abs(v0))) << toString(ctx, e) << "  ->  " << toString(ctx, s);
+    }
+  }
+  EXPECT_GT(rewritten, 300);
 }
 
 }  // namespace
