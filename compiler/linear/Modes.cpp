@@ -69,7 +69,7 @@ std::vector<Mode> firstOrderModes(const Eigen::MatrixXd& A, const std::vector<in
 // The first-order form [q; q̇]' = [0 I; -M⁻¹K -M⁻¹C] [q; q̇].
 std::vector<Mode> dampedModes(const SecondOrderSystem& s) {
   Eigen::Index n = s.M.rows();
-  Eigen::FullPivLU<Eigen::MatrixXd> lu(s.M);
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu(s.M);  // M is positive definite (linearize checks)
   Eigen::MatrixXd A = Eigen::MatrixXd::Zero(2 * n, 2 * n);
   A.topRightCorner(n, n).setIdentity();
   A.bottomLeftCorner(n, n) = -lu.solve(s.K);
