@@ -18,6 +18,7 @@
 #include "dae/Dae.h"
 #include "dae/ExplicitAlgebraics.h"
 #include "dae/Prune.h"
+#include "dae/Reroll.h"
 #include "flatten/Flatten.h"
 #include "kernel/Kernel.h"
 #include "llvm/JitModel.h"
@@ -57,6 +58,9 @@ struct CompileOptions {
   /// Keep repeated structure as templates and loops where the model allows it (docs/loops.md):
   /// `qdot run`. Elsewhere (equations, modes, …) every sum is expanded.
   bool keepLoops = false;
+  /// Make runs of rows that repeat along arrays loops again when the model was expanded to scalars
+  /// (dae::rerollRows, with keepLoops): `qdot run` and `build`.
+  bool rerollRows = false;
   /// Solve the algebraic unknowns some row defines explicitly out of the DAE (they become outputs,
   /// still result columns: dae/ExplicitAlgebraics.h): what `qdot run`, `build` and `wp` integrate.
   /// `qdot equations`, modes and linearize show and use the system as derived.
@@ -87,6 +91,8 @@ struct Compilation {
   /// Whether the model's repeated structure (sums, loops) is compiled as loops (docs/loops.md):
   /// nullopt if it has none, "" if it is, else why it is expanded to scalars (`qdot run --stats`).
   std::optional<std::string> loops;
+  /// Runs of repeating rows of a model expanded to scalars made loops again (dae::rerollRows).
+  dae::RerollResult rerolled;
   flat::Experiment experiment;  ///< the DAE's experiment annotation (kept when the DAE is released)
   std::shared_ptr<const kernel::KernelModule> kernels;
   std::optional<bc::Module> bytecode;

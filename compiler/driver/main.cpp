@@ -83,6 +83,7 @@ ExitCode emitStage(driver::Compilation& c, Options& o) {
   // What `qdot run` compiles, loops included (unless --no-loops), where the stage shown is past the DAE.
   c.options.keepLoops = driver::stageNeeded(stage) >= driver::Stage::Kernel && !o.noLoops;
   c.options.eliminateAlgebraics = c.options.keepLoops;
+  c.options.rerollRows = c.options.keepLoops;
   c.options.keepInvariants = o.run.invariants;
   ExitCode failure;
   bool ok = compileTo(c, o, driver::stageNeeded(stage), failure) && driver::emit(c, stage, std::cout);
@@ -155,6 +156,7 @@ ExitCode run(driver::Compilation& c, Options& o) {
   c.options.results = o.run.outputs;
   c.options.keepInvariants = o.run.invariants;
   c.options.keepLoops = !o.noLoops;
+  c.options.rerollRows = !o.noLoops;
   c.options.eliminateAlgebraics = true;
   c.options.releaseStages = true;
   if (std::optional<ExitCode> failed = compileToKernels(c, o)) return *failed;
@@ -169,6 +171,9 @@ ExitCode run(driver::Compilation& c, Options& o) {
   if (o.run.stats && c.loops)
     std::cerr << (c.loops->empty() ? "loops: the model's repeated structure is compiled as loops\n"
                                    : "loops: the model's repeated structure is expanded to scalars: " + *c.loops + "\n");
+  if (o.run.stats && c.rerolled.blocks)
+    std::cerr << "loops: " << c.rerolled.rows << " of the scalar rows repeat along arrays of unknowns: rerolled into "
+              << c.rerolled.blocks << (c.rerolled.blocks == 1 ? " loop\n" : " loops\n");
   if (o.run.stats && c.eliminated.eliminated)
     std::cerr << "system: " << c.eliminated.eliminated << " algebraic unknowns that their equations define "
               << "explicitly are solved out and computed with the results (qdot equations shows them)\n";
@@ -189,6 +194,7 @@ ExitCode build(driver::Compilation& c, Options& o) {
   c.options.results = o.results;
   c.options.eliminateAlgebraics = true;  // the system `qdot run` integrates, with its loops
   c.options.keepLoops = true;
+  c.options.rerollRows = true;
   c.options.keepInvariants = o.run.invariants;  // as qdot run --invariants
   if (std::string why = driver::checkOutputPath(o.exe.outputPath); !why.empty()) {
     std::cerr << "qdot: error: cannot write the executable: " << why << "\n";

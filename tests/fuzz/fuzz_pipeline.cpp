@@ -66,6 +66,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   c.options.limits.maxScalars = 20'000;  // keep each input fast; the limit itself is E0310
   c.options.keepLoops = size % 2 == 0;    // half the inputs the way `qdot run` compiles: templates and loops,
   c.options.eliminateAlgebraics = c.options.keepLoops;  // explicit algebraic unknowns solved out
+  c.options.rerollRows = c.options.keepLoops;           // and runs of repeating rows rerolled
   bool ok = driver::compileSource(c, "fuzz.qd", std::string(reinterpret_cast<const char*>(data), size), "",
                                   driver::Stage::Dae);
   checkDiagnostics(c);

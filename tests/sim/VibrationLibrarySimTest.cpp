@@ -570,6 +570,34 @@ TEST(VibrationLibrary, ChainOfComponentArraysEqualsTheFlatChain) {
   }
 }
 
+// The same two chains with 40 masses: the component chain is expanded to scalars, and its rows
+// that repeat from mass to mass are rerolled into loops (dae/Reroll.h; --stats says so). Reference:
+// the flat chain (its own loops, derived from its energies), mass by mass, and each link's law
+// b.f = k (s_i − s_{i−1}) + c (v_i − v_{i−1}) on the forces computed with the results.
+TEST(VibrationLibrary, ARerolledChainOfComponentArraysEqualsTheFlatChain) {
+  std::vector<std::string> args = {"--rtol", num(kRtol), "-p", "n=40", "--stop", "0.5"};
+  auto flat = runQdot("examples/vibration/spring_chain.qd", args);
+  args.push_back("--stats");
+  auto parts = runQdot("tests/sim/models/chain_components.qd", args);
+  ASSERT_EQ(flat.exitCode, 0) << flat.log;
+  ASSERT_EQ(parts.exitCode, 0) << parts.log;
+  EXPECT_NE(parts.log.find("rows repeat along arrays of unknowns: rerolled into 2 loops"), std::string::npos) << parts.log;
+  for (int i : {1, 2, 20, 39, 40}) {
+    const std::string index = std::to_string(i);
+    expectSameTrajectory(flat, parts, "x[" + index + "]", "ms[" + index + "].s", 0.4, 0.4 * 64, 2 * M_PI / 64);
+  }
+  const double k = 1000, c = 0.5;
+  for (int i : {1, 2, 21, 40}) {
+    const std::string at = "[" + std::to_string(i) + "]", before = "[" + std::to_string(i - 1) + "]";
+    const auto &s = parts.col("ms" + at + ".s"), &v = parts.col("der(ms" + at + ".s)"), &f = parts.col("links" + at + ".b.f");
+    for (std::size_t row = 0; row < parts.rows; ++row) {
+      double s0 = i == 1 ? 0.0 : parts.col("ms" + before + ".s")[row], v0 = i == 1 ? 0.0 : parts.col("der(ms" + before + ".s)")[row];
+      double law = k * (s[row] - s0) + c * (v[row] - v0);
+      ASSERT_NEAR(f[row], law, 1e-12 * (1 + std::fabs(law))) << "links" << at << " at t = " << parts.time()[row];
+    }
+  }
+}
+
 // The same chain's link forces: `qdot run` solves them out of the system (dae/ExplicitAlgebraics.h)
 // and computes them with the results, so the run integrates the 2n states alone (every unknown
 // differential: y'(t0) by one division, no IDACalcIC). Reference: each link's law, b.f = k (s_i −

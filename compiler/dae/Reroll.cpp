@@ -1,0 +1,304 @@
+// Rerolling (Reroll.h): each row's residual is written over placeholders for its symbols, taken in
+// symbol order, so that rows which are one expression over other symbols share one node (the
+// skeleton; hash-consing makes comparing them a pointer comparison). Rows with one skeleton, in row
+// order, form runs where every placeholder stands for the same symbol in each row (a parameter, the
+// time) or moves by a constant stride: +1 along the unknowns, any stride along the parameters. A
+// long enough run becomes a TemplateBlock whose relative symbols index arrays made of the symbols
+// the placeholders stood for, row by row.
+#include "dae/Reroll.h"
+
+#include <algorithm>
+#include <map>
+#include <tuple>
+#include <optional>
+#include <unordered_map>
+
+namespace qdot::dae {
+namespace {
+
+using sym::Expr;
+
+enum class Space : uint8_t { Unknown, Rate, Parameter, Other };
+
+// What a placeholder of a row stands for: an unknown's y or y' (by variable), a parameter, or
+// another symbol (the time), which must then be the same in every row of a run.
+struct Slot {
+  Space space = Space::Other;
+  long index = -1;
+  Expr symbol = nullptr;
+};
+
+struct RowShape {
+  Expr skeleton = nullptr;
+  std::vector<Slot> slots;
+};
+
+struct Run {
+  std::vector<int> rows;      ///< in row order
+  std::vector<long> strides;  ///< per slot: how far its index moves from row to row
+};
+
+class Reroller {
+ public:
+  Reroller(Dae& d, sym::Context& ctx, size_t minimumRun) : d_(d), ctx_(ctx), minimum_(std::max<size_t>(2, minimumRun)) {}
+
+  RerollResult run() {
+    if (d_.templated() || !d_.differentiatedRows.empty() || d_.equations.size() < minimum_) return {};
+    indexSymbols();
+    shapes_.resize(d_.equations.size());
+    for (int r : candidateRows()) shapes_[r] = shapeOf(d_.equations[r]);
+    std::vector<Run> runs = findRuns();
+    // Kinematic rows (q' = der(q): one subtraction each) are not worth loops on their own: the
+    // N-link pendulum's would only make its kernel a little slower to build.
+    if (std::all_of(runs.begin(), runs.end(), [&](const Run& r) { return kindOf(r) == flat::OriginKind::Kinematic; })) return {};
+    makeParametersConsecutive(runs);
+    if (runs.empty()) return {};
+    moveRowsTogether(runs);
+    RerollResult result;
+    for (const Run& r : runs) makeBlock(r), ++result.blocks, result.rows += r.rows.size();
+    return result;
+  }
+
+ private:
+  void indexSymbols() {
+    for (size_t j = 0; j < d_.variables.size(); ++j) {
+      where_[d_.variables[j].y] = {Space::Unknown, static_cast<long>(j)};
+      if (d_.variables[j].yp) where_[d_.variables[j].yp] = {Space::Rate, static_cast<long>(j)};
+    }
+    for (size_t k = 0; k < d_.parameters.size(); ++k) where_[d_.parameters[k].symbol] = {Space::Parameter, static_cast<long>(k)};
+  }
+
+  // The rows worth a skeleton: those among at least `minimum_` rows of one origin whose residuals
+  // agree in what a node tells at once (kind, operand count, depth). Cheap, so that a model with
+  // nothing repeated (the N-link pendulum's dense rows) pays next to nothing.
+  std::vector<int> candidateRows() const {
+    std::map<std::tuple<int, int, size_t, uint32_t>, std::vector<int>> groups;
+    for (size_t r = 0; r < d_.equations.size(); ++r)
+      if (Expr e = d_.equations[r].residual)
+        groups[{static_cast<int>(d_.equations[r].origin.kind), static_cast<int>(e->kind), e->args.size(), e->depth}].push_back(
+            static_cast<int>(r));
+    std::vector<int> rows;
+    for (const auto& [key, members] : groups)
+      if (members.size() >= minimum_) rows.insert(rows.end(), members.begin(), members.end());
+    return rows;
+  }
+
+  flat::OriginKind kindOf(const Run& r) const { return d_.equations[r.rows[0]].origin.kind; }
+
+  Expr placeholder(size_t k) {
+    while (placeholders_.size() <= k) placeholders_.push_back(ctx_.symbol("$r" + std::to_string(placeholders_.size())));
+    return placeholders_[k];
+  }
+
+  RowShape shapeOf(const Equation& e) {
+    RowShape s;
+    if (!e.residual) return s;
+    std::vector<Expr> symbols = ctx_.freeSymbols(e.residual);
+    std::sort(symbols.begin(), symbols.end(), [](Expr a, Expr b) { return a->symbolId < b->symbolId; });
+    std::unordered_map<Expr, Expr> map;
+    for (size_t k = 0; k < symbols.size(); ++k) {
+      auto at = where_.find(symbols[k]);
+      Slot slot = at == where_.end() ? Slot{} : Slot{at->second.first, at->second.second};
+      slot.symbol = symbols[k];
+      s.slots.push_back(slot);
+      map.emplace(symbols[k], placeholder(k));
+    }
+    s.skeleton = ctx_.substitute(e.residual, map);
+    return s;
+  }
+
+  // How each slot moves from row a to row b, if b may follow a in a run: the same symbol, or for an
+  // unknown the next one, for a parameter one at any distance after it. An unknown that stays the
+  // same in every row is not taken (a loop reads unknowns only through arrays).
+  std::optional<std::vector<long>> strides(int a, int b) const {
+    const RowShape &x = shapes_[a], &y = shapes_[b];
+    if (d_.equations[a].origin.kind != d_.equations[b].origin.kind) return std::nullopt;
+    std::vector<long> out(x.slots.size());
+    bool moves = false;
+    for (size_t k = 0; k < x.slots.size(); ++k) {
+      const Slot &s = x.slots[k], &t = y.slots[k];
+      if (s.space != t.space) return std::nullopt;
+      long step = t.index - s.index;
+      switch (s.space) {
+        case Space::Other:
+          if (s.symbol != t.symbol) return std::nullopt;
+          step = 0;
+          break;
+        case Space::Unknown:
+        case Space::Rate:
+          if (step != 1) return std::nullopt;
+          break;
+        case Space::Parameter:
+          if (step < 0) return std::nullopt;
+          break;
+      }
+      out[k] = step;
+      moves = moves || step != 0;
+    }
+    if (!moves) return std::nullopt;
+    return out;
+  }
+
+  std::vector<Run> findRuns() const {
+    std::unordered_map<Expr, std::vector<int>> bySkeleton;
+    std::vector<Expr> order;  // skeletons by first row: runs come out in row order
+    for (size_t r = 0; r < shapes_.size(); ++r) {
+      if (!shapes_[r].skeleton) continue;
+      auto [at, fresh] = bySkeleton.try_emplace(shapes_[r].skeleton);
+      if (fresh) order.push_back(shapes_[r].skeleton);
+      at->second.push_back(static_cast<int>(r));
+    }
+    std::vector<Run> runs;
+    for (Expr skeleton : order) {
+      const std::vector<int>& rows = bySkeleton[skeleton];
+      for (size_t i = 0; i + 1 < rows.size();) {
+        std::optional<std::vector<long>> step = strides(rows[i], rows[i + 1]);
+        if (!step) {
+          ++i;
+          continue;
+        }
+        Run run{{rows[i], rows[i + 1]}, *step};
+        size_t j = i + 2;
+        for (; j < rows.size() && strides(rows[j - 1], rows[j]) == run.strides; ++j) run.rows.push_back(rows[j]);
+        // A run kept owns its rows; a short one's last row may still start the next run.
+        bool kept = run.rows.size() >= minimum_;
+        if (kept) runs.push_back(std::move(run));
+        i = kept ? j : j - 1;
+      }
+    }
+    return runs;
+  }
+
+  // A loop reads a parameter array as p[first + i]: the parameters a run reads at a stride of more
+  // than one (a parameter of each component of an array: links[i].k, links[i].c, …) are moved next
+  // to each other, the others keep their order. Runs whose parameters still are not consecutive
+  // (two runs wanting them in different orders) stay scalar rows.
+  void makeParametersConsecutive(std::vector<Run>& runs) {
+    struct Column {
+      long first, stride, last;
+    };
+    std::vector<Column> columns;
+    for (const Run& r : runs)
+      for (size_t k = 0; k < r.strides.size(); ++k) {
+        const Slot& s = shapes_[r.rows[0]].slots[k];
+        if (s.space != Space::Parameter || r.strides[k] < 2) continue;
+        Column c{s.index, r.strides[k], s.index + r.strides[k] * static_cast<long>(r.rows.size() - 1)};
+        auto same = std::find_if(columns.begin(), columns.end(), [&](const Column& o) {
+          return o.stride == c.stride && o.first % o.stride == c.first % c.stride && c.first <= o.last + o.stride &&
+                 o.first <= c.last + c.stride;
+        });
+        if (same != columns.end()) same->first = std::min(same->first, c.first), same->last = std::max(same->last, c.last);
+        else columns.push_back(c);
+      }
+    if (!columns.empty()) {
+      std::vector<int> columnOf(d_.parameters.size(), -1);
+      for (size_t c = 0; c < columns.size(); ++c)
+        for (long p = columns[c].first; p <= columns[c].last; p += columns[c].stride)
+          if (columnOf[p] < 0) columnOf[p] = static_cast<int>(c);
+      std::vector<long> newIndex(d_.parameters.size(), -1);
+      std::vector<Parameter> permuted;
+      permuted.reserve(d_.parameters.size());
+      auto emit = [&](long p) {
+        if (newIndex[p] >= 0) return;
+        newIndex[p] = static_cast<long>(permuted.size());
+        permuted.push_back(std::move(d_.parameters[p]));
+      };
+      std::vector<char> placed(columns.size(), 0);
+      for (long p = 0; p < static_cast<long>(d_.parameters.size()); ++p) {
+        if (int c = columnOf[p]; c >= 0 && !placed[c]) {  // the whole column where its first member was
+          placed[c] = 1;
+          for (long q = columns[c].first; q <= columns[c].last; q += columns[c].stride)
+            if (columnOf[q] == c) emit(q);
+        }
+        emit(p);
+      }
+      d_.parameters = std::move(permuted);
+      for (RowShape& s : shapes_)
+        for (Slot& slot : s.slots)
+          if (slot.space == Space::Parameter) slot.index = newIndex[slot.index];
+    }
+    std::erase_if(runs, [&](const Run& r) { return !parametersConsecutive(r); });
+  }
+
+  bool parametersConsecutive(const Run& r) const {
+    for (size_t k = 0; k < r.strides.size(); ++k) {
+      if (shapes_[r.rows[0]].slots[k].space != Space::Parameter || r.strides[k] == 0) continue;
+      for (size_t j = 1; j < r.rows.size(); ++j)
+        if (shapes_[r.rows[j]].slots[k].index != shapes_[r.rows[j - 1]].slots[k].index + 1) return false;
+    }
+    return true;
+  }
+
+  // Each run's rows next to each other, where its first row was; the derivative links and the
+  // Euler–Lagrange rows' coordinates follow their rows. (A run holds rows of one origin, so the
+  // Euler–Lagrange rows stay first.)
+  void moveRowsTogether(std::vector<Run>& runs) {
+    std::vector<int> runOf(d_.equations.size(), -1);
+    for (size_t k = 0; k < runs.size(); ++k)
+      for (int r : runs[k].rows) runOf[r] = static_cast<int>(k);
+    std::vector<int> newRow(d_.equations.size(), -1), order;
+    order.reserve(d_.equations.size());
+    for (size_t r = 0; r < d_.equations.size(); ++r) {
+      if (newRow[r] >= 0) continue;
+      if (runOf[r] < 0) {
+        newRow[r] = static_cast<int>(order.size()), order.push_back(static_cast<int>(r));
+        continue;
+      }
+      for (int q : runs[runOf[r]].rows) newRow[q] = static_cast<int>(order.size()), order.push_back(q);
+    }
+    std::vector<Equation> equations;
+    std::vector<RowShape> shapes;
+    equations.reserve(order.size());
+    shapes.reserve(order.size());
+    for (int r : order) equations.push_back(std::move(d_.equations[r])), shapes.push_back(std::move(shapes_[r]));
+    d_.equations = std::move(equations);
+    shapes_ = std::move(shapes);
+    std::vector<std::string> coordinates(d_.rowCoordinates.size());
+    for (size_t r = 0; r < d_.rowCoordinates.size(); ++r) coordinates[newRow[r]] = std::move(d_.rowCoordinates[r]);
+    d_.rowCoordinates = std::move(coordinates);
+    for (DerivativeLink& l : d_.links) l.row = newRow[l.row];
+    for (Run& run : runs)
+      for (int& r : run.rows) r = newRow[r];
+  }
+
+  // The array of the symbols slot k stands for, row by row (one array per distinct sequence).
+  Expr relativeSymbol(const Run& r, size_t k) {
+    std::vector<Expr> elements;
+    elements.reserve(r.rows.size());
+    for (int row : r.rows) elements.push_back(shapes_[row].slots[k].symbol);
+    std::string name = "{" + ctx_.symbolName(elements.front()) + "…" + ctx_.symbolName(elements.back()) + "}";
+    auto [at, fresh] = arrays_.try_emplace(name, 0);
+    if (fresh) {
+      at->second = static_cast<int>(d_.patterns->arrays.size());
+      d_.patterns->arrays.push_back({name, {static_cast<int>(elements.size())}, std::move(elements), -1});
+    }
+    return d_.patterns->symbol(ctx_, {at->second, {{0, 0}}});
+  }
+
+  void makeBlock(const Run& r) {
+    if (!d_.patterns) d_.patterns = std::make_shared<flat::ElementPatterns>();
+    const RowShape& first = shapes_[r.rows[0]];
+    std::unordered_map<Expr, Expr> map;
+    for (size_t k = 0; k < r.strides.size(); ++k)
+      if (r.strides[k] != 0) map.emplace(first.slots[k].symbol, relativeSymbol(r, k));
+    Equation& e = d_.equations[r.rows[0]];
+    Expr residual = ctx_.substitute(e.residual, map);
+    auto n = static_cast<long>(r.rows.size());
+    d_.templateBlocks.push_back({r.rows[0], {static_cast<int>(n)}, {{1, n}}, residual, e.origin.kind, e.origin.range});
+    for (int row : r.rows) d_.equations[row].residual = nullptr;
+  }
+
+  Dae& d_;
+  sym::Context& ctx_;
+  size_t minimum_;
+  std::unordered_map<Expr, std::pair<Space, long>> where_;
+  std::vector<RowShape> shapes_;
+  std::vector<Expr> placeholders_;
+  std::unordered_map<std::string, int> arrays_;
+};
+
+}  // namespace
+
+RerollResult rerollRows(Dae& dae, sym::Context& ctx, size_t minimumRun) { return Reroller(dae, ctx, minimumRun).run(); }
+
+}  // namespace qdot::dae

@@ -1,0 +1,146 @@
+// dae::rerollRows (dae/Reroll.h): runs of scalar rows that are one row shifted along the unknowns
+// and parameters become template blocks. Reference: the same DAE not rerolled — its kernels give
+// the same residual and Jacobian, row by row and entry by entry (rows are matched by their origin,
+// since rerolling moves them), at random states, with default and with given parameter values.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <sstream>
+#include <string>
+
+#include "dae/Reroll.h"
+#include "kernel/Kernel.h"
+#include "unit/pipeline/KernelPair.h"
+
+namespace qdot {
+namespace {
+
+// The chain of spring-dampers and masses from arrays of library components (as
+// tests/sim/models/chain_components.qd), n masses.
+std::string componentChain(int n) {
+  return "model C\n  import Vibration.*;\n  parameter Integer n = " + std::to_string(n) +
+         ";\n  Fixed wall;\n"
+         "  SpringDamper links[n](k = {1000 + 10*i for i in 1:n}, c = fill(0.5, n));\n"
+         "  Mass ms[n](m = {1 + 0.01*i for i in 1:n}, s(start = {0.01*i for i in 1:n}));\n"
+         "equation\n  connect(wall.a, links[1].a);\n"
+         "  for i in 1:n loop\n    connect(links[i].b, ms[i].a);\n  end for;\n"
+         "  for i in 2:n loop\n    connect(ms[i - 1].b, links[i].a);\n  end for;\nend C;\n";
+}
+
+// The model's DAE as `qdot run` has it before rerolling: expanded to scalars, the explicit
+// algebraic unknowns (the link forces) solved out.
+struct ScalarDae {
+  driver::Compilation c;
+  bool ok = false;
+  explicit ScalarDae(const std::string& text) {
+    c.options.eliminateAlgebraics = true;
+    ok = driver::compileSource(c, "model.qd", text, driver::Stage::Dae);
+  }
+};
+
+// What identifies a row whichever its position: its origin.
+std::string rowKey(const dae::Equation& e) {
+  std::ostringstream os;
+  os << static_cast<int>(e.origin.kind) << ':' << e.origin.variable << ':' << e.origin.range.file << '@' << e.origin.range.begin << ':'
+     << e.origin.element;
+  return os.str();
+}
+
+struct Evaluated {
+  std::map<std::string, double> F;                                  // by row
+  std::map<std::pair<std::string, int>, double> J;                  // by (row, column)
+};
+
+Evaluated evaluated(const dae::Dae& d, const kernel::KernelModule& k, int trial, const test::GivenParameters& given = {}) {
+  test::KernelValues v = test::evaluateAt(k, trial, given);
+  Evaluated out;
+  for (size_t r = 0; r < d.equations.size(); ++r) out.F[rowKey(d.equations[r])] = v.F[r];
+  const auto& starts = k.description.jacobianColumnStarts;
+  const auto& rows = k.description.jacobianRowIndices;
+  for (size_t col = 0; col + 1 < starts.size(); ++col)
+    for (int32_t at = starts[col]; at < starts[col + 1]; ++at)
+      out.J[{rowKey(d.equations[rows[at]]), static_cast<int>(col)}] = v.J[at];
+  return out;
+}
+
+void expectSame(const Evaluated& a, const Evaluated& b) {
+  ASSERT_EQ(a.F.size(), b.F.size());
+  for (const auto& [row, value] : a.F) EXPECT_NEAR(b.F.at(row), value, 1e-12 * (1 + std::fabs(value))) << row;
+  ASSERT_EQ(a.J.size(), b.J.size()) << "the same Jacobian pattern";
+  for (const auto& [entry, value] : a.J) {
+    auto at = b.J.find(entry);
+    ASSERT_NE(at, b.J.end()) << entry.first << ", column " << entry.second;
+    EXPECT_NEAR(at->second, value, 1e-12 * (1 + std::fabs(value))) << entry.first << ", column " << entry.second;
+  }
+}
+
+TEST(RerollRows, AChainOfComponentArraysLoopsWithTheScalarKernelsValues) {
+  const int n = 40;
+  ScalarDae model(componentChain(n));
+  ASSERT_TRUE(model.ok);
+  dae::Dae scalar = *model.c.dae;
+  dae::Dae rerolled = *model.c.dae;
+  dae::RerollResult r = dae::rerollRows(rerolled, model.c.ctx);
+  // The masses' rows but the first (the wall's link) and the last (no link after it), and the
+  // kinematic rows: two loops.
+  EXPECT_EQ(r.blocks, 2u);
+  EXPECT_EQ(r.rows, static_cast<size_t>((n - 2) + n));
+  ASSERT_EQ(rerolled.templateBlocks.size(), r.blocks);
+  for (const dae::TemplateBlock& b : rerolled.templateBlocks)
+    for (int row = b.firstRow; row < b.firstRow + static_cast<int>(flat::pointCount(b.region)); ++row)
+      EXPECT_EQ(rerolled.equations[row].residual, nullptr) << "a block's rows are its template's";
+
+  DiagnosticEngine diags;
+  kernel::KernelModule a = kernel::buildKernels(scalar, model.c.ctx, diags);
+  kernel::KernelModule b = kernel::buildKernels(rerolled, model.c.ctx, diags);
+  ASSERT_FALSE(diags.hasErrors());
+  EXPECT_EQ(test::loopCount(a.program(ModelProgram::Residual)), 0u);
+  EXPECT_EQ(test::loopCount(b.program(ModelProgram::Residual)), 2u);
+  EXPECT_LT(b.program(ModelProgram::Residual).code.size(), a.program(ModelProgram::Residual).code.size() / 5);
+  EXPECT_EQ(a.description.parameterNames.size(), b.description.parameterNames.size());
+  for (int trial = 0; trial < 3; ++trial) expectSame(evaluated(scalar, a, trial), evaluated(rerolled, b, trial));
+  // The links' parameters were interleaved (k, c, s0 of each link) and are now one array each;
+  // values given by name still reach the same parameters.
+  test::GivenParameters given{{"links[7].k", 2500}, {"links[40].c", 3}, {"ms[13].m", 7}, {"links[2].s0", 0.25}};
+  expectSame(evaluated(scalar, a, 5, given), evaluated(rerolled, b, 5, given));
+}
+
+TEST(RerollRows, ShortRunsStayRows) {
+  ScalarDae model(componentChain(12));  // runs of 10 and 12 rows: under the 16 a loop needs
+  ASSERT_TRUE(model.ok);
+  dae::Dae d = *model.c.dae;
+  EXPECT_EQ(dae::rerollRows(d, model.c.ctx).blocks, 0u);
+  EXPECT_FALSE(d.templated());
+  EXPECT_EQ(dae::rerollRows(d, model.c.ctx, 8).blocks, 2u) << "a lower minimum takes them";
+}
+
+// Every row reads one common unknown (the frame position y): a loop reads unknowns only through
+// arrays, so the rows stay scalar. (Compiled without loops: the model is expanded to scalars.)
+TEST(RerollRows, RowsReadingOneCommonUnknownStayRows) {
+  driver::Compilation c;
+  ASSERT_TRUE(driver::compileSource(c, "m.qd",
+                                    "model M\n  parameter Integer n = 30;\n  coordinate Real x[n](start = {0.01*i for i in 1:n});\n"
+                                    "  coordinate Real y(start = 0.1);\nmechanics\n"
+                                    "  kinetic = sum(0.5*der(x[i])^2 for i in 1:n) + 0.5*der(y)^2;\n"
+                                    "  potential = sum(0.5*(x[i] - y)^2 for i in 1:n) + 0.5*y^2;\nend M;\n",
+                                    driver::Stage::Dae));
+  dae::Dae d = *c.dae;
+  dae::RerollResult r = dae::rerollRows(d, c.ctx);
+  EXPECT_EQ(r.blocks, 0u) << "the rows of x read y, the kinematic rows alone are not worth a loop";
+}
+
+// `qdot run`'s pipeline: a chain of components of 40 masses is rerolled, and says so.
+TEST(RerollRows, QdotRunRerollsAndReportsIt) {
+  test::CompiledKernels looped(componentChain(40), true, true);
+  ASSERT_TRUE(looped.ok) << looped.diagnostics();
+  EXPECT_EQ(looped.c.rerolled.blocks, 0u) << "off unless asked for (tests keep the scalar path)";
+  driver::Compilation c;
+  c.options.keepLoops = c.options.rerollRows = c.options.eliminateAlgebraics = true;
+  ASSERT_TRUE(driver::compileSource(c, "model.qd", componentChain(40), driver::Stage::Kernel));
+  EXPECT_EQ(c.rerolled.blocks, 2u);
+  EXPECT_EQ(test::loopCount(c.kernels->program(ModelProgram::Residual)), 2u);
+}
+
+}  // namespace
+}  // namespace qdot
