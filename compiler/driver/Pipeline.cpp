@@ -386,7 +386,7 @@ bool buildDae(Compilation& c) {
       c.pruned = dae::pruneToResults(*d, names, c.ctx);
     }
     if (d && !dae::reduceIndex(*d, c.ctx, c.diags)) d.reset();
-    if (d && c.options.keepLoops && c.options.rerollRows) c.rerolled = dae::rerollRows(*d, c.ctx);
+    if (d && c.options.keepLoops && c.options.rerollRows) c.rerolled = dae::rerollRows(*d, c.ctx, c.options.rerollMinimumRun);
     return d;
   });
   if (c.dae) c.experiment = c.dae->experiment;

@@ -61,6 +61,7 @@ struct CompileOptions {
   /// Make runs of rows that repeat along arrays loops again when the model was expanded to scalars
   /// (dae::rerollRows, with keepLoops): `qdot run` and `build`.
   bool rerollRows = false;
+  size_t rerollMinimumRun = 16;  ///< the shortest run of rows made a loop (tests and fuzzing lower it)
   /// Solve the algebraic unknowns some row defines explicitly out of the DAE (they become outputs,
   /// still result columns: dae/ExplicitAlgebraics.h): what `qdot run`, `build` and `wp` integrate.
   /// `qdot equations`, modes and linearize show and use the system as derived.

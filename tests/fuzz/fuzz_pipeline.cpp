@@ -66,7 +66,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   c.options.limits.maxScalars = 20'000;  // keep each input fast; the limit itself is E0310
   c.options.keepLoops = size % 2 == 0;    // half the inputs the way `qdot run` compiles: templates and loops,
   c.options.eliminateAlgebraics = c.options.keepLoops;  // explicit algebraic unknowns solved out
-  c.options.rerollRows = c.options.keepLoops;           // and runs of repeating rows rerolled
+  c.options.rerollRows = c.options.keepLoops;           // and runs of repeating rows rerolled,
+  c.options.rerollMinimumRun = 2;                        // however short (small inputs have short runs)
   bool ok = driver::compileSource(c, "fuzz.qd", std::string(reinterpret_cast<const char*>(data), size), "",
                                   driver::Stage::Dae);
   checkDiagnostics(c);
