@@ -99,6 +99,16 @@ struct TemplateBlock {
   SourceRange range;  ///< the array's declaration
 };
 
+/// Outputs given by one template (dae::rerollOutputs' runs): outputs [first, first + count), each
+/// the value at its point i = 1..count of an expression over relative symbols (Dae::patterns) whose
+/// arrays have `count` elements; those outputs' Output::value is null.
+struct OutputBlock {
+  int first = -1;
+  int count = 0;
+  sym::Expr value = nullptr;
+  SourceRange range;  ///< the first output's
+};
+
 struct Dae {
   std::string name, description;
   SourceRange range;
@@ -125,6 +135,7 @@ struct Dae {
   /// Rows kept as templates (only when the equations of motion have template rows) and the
   /// relative symbols' table they use.
   std::vector<TemplateBlock> templateBlocks;
+  std::vector<OutputBlock> outputBlocks;  ///< outputs kept as templates (rerolled)
   std::shared_ptr<flat::ElementPatterns> patterns;
 
   bool templated() const { return !templateBlocks.empty(); }

@@ -8,6 +8,7 @@
 #include "dae/Reroll.h"
 
 #include <algorithm>
+#include <climits>
 #include <map>
 #include <tuple>
 #include <optional>
@@ -43,29 +44,76 @@ class Reroller {
   Reroller(Dae& d, sym::Context& ctx, size_t minimumRun) : d_(d), ctx_(ctx), minimum_(std::max<size_t>(2, minimumRun)) {}
 
   RerollResult run() {
-    if (d_.templated() || !d_.differentiatedRows.empty() || d_.equations.size() < minimum_) return {};
-    indexSymbols();
-    shapes_.resize(d_.equations.size());
-    for (int r : candidateRows()) shapes_[r] = shapeOf(d_.equations[r]);
-    std::vector<Run> runs = findRuns();
-    // Kinematic rows (q' = der(q): one subtraction each) are not worth loops on their own: the
-    // N-link pendulum's would only make its kernel a little slower to build.
-    if (std::all_of(runs.begin(), runs.end(), [&](const Run& r) { return kindOf(r) == flat::OriginKind::Kinematic; })) return {};
-    makeParametersConsecutive(runs);
-    if (runs.empty()) return {};
-    moveRowsTogether(runs);
     RerollResult result;
-    for (const Run& r : runs) makeBlock(r), ++result.blocks, result.rows += r.rows.size();
+    if (d_.templated() || !d_.differentiatedRows.empty()) return result;
+    indexSymbols();
+    rerollRowRuns(result);
+    rerollOutputRuns(result);
     return result;
   }
 
  private:
+  void rerollRowRuns(RerollResult& result) {
+    if (d_.equations.size() < minimum_) return;
+    shapes_.resize(d_.equations.size());
+    for (int r : candidateRows()) shapes_[r] = shapeOf(d_.equations[r].residual);
+    std::vector<Run> runs = findRuns();
+    // Kinematic rows (q' = der(q): one subtraction each) are not worth loops on their own: the
+    // N-link pendulum's would only make its kernel a little slower to build.
+    if (std::all_of(runs.begin(), runs.end(), [&](const Run& r) { return kindOf(r) == flat::OriginKind::Kinematic; })) return;
+    makeParametersConsecutive(runs);
+    if (runs.empty()) return;
+    moveRowsTogether(runs);
+    for (const Run& r : runs) makeBlock(r), ++result.blocks, result.rows += r.rows.size();
+  }
+
+  // Outputs keep their order (it is the result columns'): runs of consecutive outputs of one
+  // skeleton and kind, along the unknowns and along parameters already consecutive, become
+  // OutputBlocks (a component array's flows, which the DAE solved out of the system).
+  void rerollOutputRuns(RerollResult& result) {
+    if (d_.outputs.size() < minimum_) return;
+    indexParameters();  // (the rows' runs may have moved them)
+    std::vector<RowShape> shapes(d_.outputs.size());
+    for (size_t i = 0; i < d_.outputs.size(); ++i)
+      if (d_.outputs[i].value && d_.outputs[i].sums.empty()) shapes[i] = shapeOf(d_.outputs[i].value);
+    auto follows = [&](size_t a, size_t b) -> std::optional<std::vector<long>> {
+      if (!shapes[a].skeleton || shapes[a].skeleton != shapes[b].skeleton || d_.outputs[a].kind != d_.outputs[b].kind)
+        return std::nullopt;
+      return strides(shapes[a], shapes[b], 1);
+    };
+    for (size_t i = 0; i + 1 < shapes.size();) {
+      std::optional<std::vector<long>> step = follows(i, i + 1);
+      if (!step) {
+        ++i;
+        continue;
+      }
+      size_t j = i + 2;
+      while (j < shapes.size() && follows(j - 1, j) == step) ++j;
+      if (j - i < minimum_) {
+        i = j - 1;
+        continue;
+      }
+      std::vector<int> members;
+      for (size_t k = i; k < j; ++k) members.push_back(static_cast<int>(k));
+      makeOutputBlock(shapes, members, *step);
+      ++result.outputBlocks, result.outputs += members.size();
+      i = j;
+    }
+  }
+
   void indexSymbols() {
     for (size_t j = 0; j < d_.variables.size(); ++j) {
-      where_[d_.variables[j].y] = {Space::Unknown, static_cast<long>(j)};
-      if (d_.variables[j].yp) where_[d_.variables[j].yp] = {Space::Rate, static_cast<long>(j)};
+      place(d_.variables[j].y, Space::Unknown, j);
+      if (d_.variables[j].yp) place(d_.variables[j].yp, Space::Rate, j);
     }
-    for (size_t k = 0; k < d_.parameters.size(); ++k) where_[d_.parameters[k].symbol] = {Space::Parameter, static_cast<long>(k)};
+    indexParameters();
+  }
+  void indexParameters() {
+    for (size_t k = 0; k < d_.parameters.size(); ++k) place(d_.parameters[k].symbol, Space::Parameter, k);
+  }
+  void place(Expr symbol, Space space, size_t index) {
+    if (where_.size() <= symbol->symbolId) where_.resize(symbol->symbolId + 1, {Space::Other, -1});
+    where_[symbol->symbolId] = {space, static_cast<long>(index)};
   }
 
   // The rows worth a skeleton: those among at least `minimum_` rows of one origin whose residuals
@@ -90,20 +138,21 @@ class Reroller {
     return placeholders_[k];
   }
 
-  RowShape shapeOf(const Equation& e) {
+  RowShape shapeOf(Expr value) {
     RowShape s;
-    if (!e.residual) return s;
-    std::vector<Expr> symbols = ctx_.freeSymbols(e.residual);
+    if (!value) return s;
+    std::vector<Expr> symbols = ctx_.freeSymbols(value);
     std::sort(symbols.begin(), symbols.end(), [](Expr a, Expr b) { return a->symbolId < b->symbolId; });
-    std::unordered_map<Expr, Expr> map;
+    std::unordered_map<Expr, Expr>& map = placeholderMap_;
+    map.clear();
     for (size_t k = 0; k < symbols.size(); ++k) {
-      auto at = where_.find(symbols[k]);
-      Slot slot = at == where_.end() ? Slot{} : Slot{at->second.first, at->second.second};
+      uint32_t id = symbols[k]->symbolId;
+      Slot slot = id < where_.size() ? Slot{where_[id].first, where_[id].second} : Slot{};
       slot.symbol = symbols[k];
       s.slots.push_back(slot);
       map.emplace(symbols[k], placeholder(k));
     }
-    s.skeleton = ctx_.substitute(e.residual, map);
+    s.skeleton = ctx_.substitute(value, map);
     return s;
   }
 
@@ -111,8 +160,10 @@ class Reroller {
   // unknown the next one, for a parameter one at any distance after it. An unknown that stays the
   // same in every row is not taken (a loop reads unknowns only through arrays).
   std::optional<std::vector<long>> strides(int a, int b) const {
-    const RowShape &x = shapes_[a], &y = shapes_[b];
     if (d_.equations[a].origin.kind != d_.equations[b].origin.kind) return std::nullopt;
+    return strides(shapes_[a], shapes_[b]);
+  }
+  static std::optional<std::vector<long>> strides(const RowShape& x, const RowShape& y, long parameterStride = LONG_MAX) {
     std::vector<long> out(x.slots.size());
     bool moves = false;
     for (size_t k = 0; k < x.slots.size(); ++k) {
@@ -129,7 +180,7 @@ class Reroller {
           if (step != 1) return std::nullopt;
           break;
         case Space::Parameter:
-          if (step < 0) return std::nullopt;
+          if (step < 0 || step > parameterStride) return std::nullopt;
           break;
       }
       out[k] = step;
@@ -261,11 +312,12 @@ class Reroller {
       for (int& r : run.rows) r = newRow[r];
   }
 
-  // The array of the symbols slot k stands for, row by row (one array per distinct sequence).
-  Expr relativeSymbol(const Run& r, size_t k) {
+  // The array of the symbols slot k stands for, member by member (one array per distinct sequence).
+  Expr relativeSymbol(const std::vector<RowShape>& shapes, const std::vector<int>& members, size_t k) {
+    if (!d_.patterns) d_.patterns = std::make_shared<flat::ElementPatterns>();
     std::vector<Expr> elements;
-    elements.reserve(r.rows.size());
-    for (int row : r.rows) elements.push_back(shapes_[row].slots[k].symbol);
+    elements.reserve(members.size());
+    for (int m : members) elements.push_back(shapes[m].slots[k].symbol);
     std::string name = "{" + ctx_.symbolName(elements.front()) + "…" + ctx_.symbolName(elements.back()) + "}";
     auto [at, fresh] = arrays_.try_emplace(name, 0);
     if (fresh) {
@@ -275,14 +327,25 @@ class Reroller {
     return d_.patterns->symbol(ctx_, {at->second, {{0, 0}}});
   }
 
-  void makeBlock(const Run& r) {
-    if (!d_.patterns) d_.patterns = std::make_shared<flat::ElementPatterns>();
-    const RowShape& first = shapes_[r.rows[0]];
+  // The first member's value with each moving symbol replaced by its array's relative symbol.
+  Expr templateOf(const std::vector<RowShape>& shapes, const std::vector<int>& members, const std::vector<long>& strides,
+                  Expr value) {
     std::unordered_map<Expr, Expr> map;
-    for (size_t k = 0; k < r.strides.size(); ++k)
-      if (r.strides[k] != 0) map.emplace(first.slots[k].symbol, relativeSymbol(r, k));
+    for (size_t k = 0; k < strides.size(); ++k)
+      if (strides[k] != 0) map.emplace(shapes[members[0]].slots[k].symbol, relativeSymbol(shapes, members, k));
+    return ctx_.substitute(value, map);
+  }
+
+  void makeOutputBlock(const std::vector<RowShape>& shapes, const std::vector<int>& members, const std::vector<long>& strides) {
+    flat::Output& first = d_.outputs[members[0]];
+    Expr value = templateOf(shapes, members, strides, first.value);
+    d_.outputBlocks.push_back({members[0], static_cast<int>(members.size()), value, first.range});
+    for (int m : members) d_.outputs[m].value = nullptr;
+  }
+
+  void makeBlock(const Run& r) {
     Equation& e = d_.equations[r.rows[0]];
-    Expr residual = ctx_.substitute(e.residual, map);
+    Expr residual = templateOf(shapes_, r.rows, r.strides, e.residual);
     auto n = static_cast<long>(r.rows.size());
     d_.templateBlocks.push_back({r.rows[0], {static_cast<int>(n)}, {{1, n}}, residual, e.origin.kind, e.origin.range});
     for (int row : r.rows) d_.equations[row].residual = nullptr;
@@ -291,9 +354,10 @@ class Reroller {
   Dae& d_;
   sym::Context& ctx_;
   size_t minimum_;
-  std::unordered_map<Expr, std::pair<Space, long>> where_;
+  std::vector<std::pair<Space, long>> where_;  ///< by symbolId: what each symbol of the DAE is
   std::vector<RowShape> shapes_;
   std::vector<Expr> placeholders_;
+  std::unordered_map<Expr, Expr> placeholderMap_;  ///< shapeOf's, kept to spare an allocation per row
   std::unordered_map<std::string, int> arrays_;
 };
 

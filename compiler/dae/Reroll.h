@@ -13,8 +13,10 @@
 namespace qdot::dae {
 
 struct RerollResult {
-  size_t blocks = 0;  ///< template blocks made
-  size_t rows = 0;    ///< rows they hold
+  size_t blocks = 0;        ///< template blocks made
+  size_t rows = 0;          ///< rows they hold
+  size_t outputBlocks = 0;  ///< output blocks made
+  size_t outputs = 0;       ///< outputs they hold
 };
 
 /// Finds runs of at least `minimumRun` rows that are one expression over consecutive unknowns (the
@@ -23,7 +25,8 @@ struct RerollResult {
 /// (the derivative links and the Euler–Lagrange rows' coordinates move with them), its parameters
 /// made consecutive in `parameters` where a stride separated them. The DAE must be scalar (no
 /// template blocks) and of index 1 (no differentiated rows); otherwise, or if nothing repeats,
-/// it is left as it was.
+/// it is left as it was. Then the same for runs of consecutive outputs (their order is the result
+/// columns', so it is kept), along the unknowns and parameters that are consecutive: OutputBlocks.
 RerollResult rerollRows(Dae& dae, sym::Context& ctx, size_t minimumRun = 16);
 
 }  // namespace qdot::dae

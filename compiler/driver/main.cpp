@@ -174,6 +174,9 @@ ExitCode run(driver::Compilation& c, Options& o) {
   if (o.run.stats && c.rerolled.blocks)
     std::cerr << "loops: " << c.rerolled.rows << " of the scalar rows repeat along arrays of unknowns: rerolled into "
               << c.rerolled.blocks << (c.rerolled.blocks == 1 ? " loop\n" : " loops\n");
+  if (o.run.stats && c.rerolled.outputBlocks)
+    std::cerr << "loops: " << c.rerolled.outputs << " outputs repeat along arrays of unknowns: computed by "
+              << c.rerolled.outputBlocks << (c.rerolled.outputBlocks == 1 ? " loop\n" : " loops\n");
   if (o.run.stats && c.eliminated.eliminated)
     std::cerr << "system: " << c.eliminated.eliminated << " algebraic unknowns that their equations define "
               << "explicitly are solved out and computed with the results (qdot equations shows them)\n";

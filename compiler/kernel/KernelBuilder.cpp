@@ -619,33 +619,60 @@ class Builder {
   // --- outputs and invariants --------------------------------------------------------------------
 
   // out[i] = values[i]; `after` may add to them (an invariant's sums).
+  // out[slots[i]] = values[i] (slots empty: out[i]), `count` outputs in all; `after` may add to
+  // them (an invariant's sums) or store the others (output blocks).
   template <class After = void (*)(ProgramBuilder&)>
   Program buildMonitor(ModelProgram program, const std::vector<Expr>& values, const std::vector<uint32_t>& sources,
-                       After after = [](ProgramBuilder&) {}) {
+                       After after = [](ProgramBuilder&) {}, const std::vector<uint32_t>& slots = {},
+                       std::optional<size_t> count = std::nullopt) {
     sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, values, "$t");
     ProgramBuilder b(programName(program));
     bindInputs(b, true);
     for (const auto& [t, value] : cse.temporaries) b.bindTemporary(t, value);
-    for (uint32_t i = 0; i < values.size(); ++i) b.setSource(sources[i]), b.store(i, b.lower(cse.outputs[i]));
+    for (uint32_t i = 0; i < values.size(); ++i)
+      b.setSource(sources[i]), b.store(slots.empty() ? i : slots[i], b.lower(cse.outputs[i]));
     after(b);
     reportUnbound(b, programName(program), "declare it as a variable or a parameter");
-    return b.finish(static_cast<uint32_t>(values.size()));
+    return b.finish(static_cast<uint32_t>(count.value_or(values.size())));
   }
 
+  // The outputs with a value of their own, then the sums of some and the output blocks (one loop each).
   Program buildOutputs() {
     std::vector<Expr> values;
-    std::vector<uint32_t> sources;
-    for (const auto& o : dae_.outputs) {
+    std::vector<uint32_t> sources, slots;
+    for (uint32_t i = 0; i < dae_.outputs.size(); ++i) {
+      const flat::Output& o = dae_.outputs[i];
+      if (!o.value) continue;  // an output block's
       values.push_back(o.value);
+      slots.push_back(i);
       sources.push_back(addSource("output " + o.name, o.range, o.name + " = " + sym::toString(ctx_, o.value)));
     }
-    return buildMonitor(ModelProgram::Outputs, values, sources, [&](ProgramBuilder& b) {
+    auto after = [&](ProgramBuilder& b) {
       LoopOperands operands(dae_, ctx_, unknowns());
       for (uint32_t i = 0; i < dae_.outputs.size(); ++i)
         for (size_t k = 0; k < dae_.outputs[i].sums.size(); ++k)
           emitSum(b, i, dae_.outputs[i].sums[k], "output " + dae_.outputs[i].name, "$o" + std::to_string(i) + "_" + std::to_string(k),
                   dae_.outputs[i].range, operands);
-    });
+      for (size_t k = 0; k < dae_.outputBlocks.size(); ++k) emitOutputBlock(b, k, operands);
+    };
+    return buildMonitor(ModelProgram::Outputs, values, sources, after, slots, dae_.outputs.size());
+  }
+
+  // Outputs first..first + count − 1 of an output block: one loop storing its value at each point.
+  void emitOutputBlock(ProgramBuilder& b, size_t k, LoopOperands& reader) {
+    const dae::OutputBlock& block = dae_.outputBlocks[k];
+    std::vector<int> shape{block.count};
+    flat::Box box{{1, block.count}};
+    std::vector<Operand> operands = reader.read(shape, box, block.value);
+    std::vector<Expr> body{block.value};
+    std::vector<Expr> perIteration = iteratorsFromOffset(b, body, box);
+    sym::CseResult cse = sym::eliminateCommonSubexpressions(ctx_, body, "$ob" + std::to_string(k));
+    const std::string& first = dae_.outputs[block.first].name;
+    const std::string& last = dae_.outputs[block.first + block.count - 1].name;
+    b.setSource(addSource("outputs " + first + " … " + last + " (one loop)", block.range));
+    long base = openLoop(b, cse, operands, perIteration, shape, box);
+    b.storeLooped(static_cast<uint32_t>(block.first + base), b.lower(cse.outputs[0]));
+    b.endLoop();
   }
 
   Program buildInvariants() {

@@ -573,7 +573,7 @@ TEST(VibrationLibrary, ChainOfComponentArraysEqualsTheFlatChain) {
 // The same two chains with 40 masses: the component chain is expanded to scalars, and its rows
 // that repeat from mass to mass are rerolled into loops (dae/Reroll.h; --stats says so). Reference:
 // the flat chain (its own loops, derived from its energies), mass by mass, and each link's law
-// b.f = k (s_i − s_{i−1}) + c (v_i − v_{i−1}) on the forces computed with the results.
+// b.f = k (s_i − s_{i−1}) + c (v_i − v_{i−1}) on the forces computed with the results (by loops too).
 TEST(VibrationLibrary, ARerolledChainOfComponentArraysEqualsTheFlatChain) {
   std::vector<std::string> args = {"--rtol", num(kRtol), "-p", "n=40", "--stop", "0.5"};
   auto flat = runQdot("examples/vibration/spring_chain.qd", args);
@@ -582,6 +582,7 @@ TEST(VibrationLibrary, ARerolledChainOfComponentArraysEqualsTheFlatChain) {
   ASSERT_EQ(flat.exitCode, 0) << flat.log;
   ASSERT_EQ(parts.exitCode, 0) << parts.log;
   EXPECT_NE(parts.log.find("rows repeat along arrays of unknowns: rerolled into 2 loops"), std::string::npos) << parts.log;
+  EXPECT_NE(parts.log.find("outputs repeat along arrays of unknowns: computed by 4 loops"), std::string::npos) << parts.log;
   for (int i : {1, 2, 20, 39, 40}) {
     const std::string index = std::to_string(i);
     expectSameTrajectory(flat, parts, "x[" + index + "]", "ms[" + index + "].s", 0.4, 0.4 * 64, 2 * M_PI / 64);

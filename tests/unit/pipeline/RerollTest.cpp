@@ -51,13 +51,15 @@ std::string rowKey(const dae::Equation& e) {
 }
 
 struct Evaluated {
-  std::map<std::string, double> F;                                  // by row
-  std::map<std::pair<std::string, int>, double> J;                  // by (row, column)
+  std::map<std::string, double> F;                  // by row
+  std::map<std::pair<std::string, int>, double> J;  // by (row, column)
+  std::vector<double> outputs;                      // in their order (the result columns')
 };
 
 Evaluated evaluated(const dae::Dae& d, const kernel::KernelModule& k, int trial, const test::GivenParameters& given = {}) {
   test::KernelValues v = test::evaluateAt(k, trial, given);
   Evaluated out;
+  out.outputs = v.outputs;
   for (size_t r = 0; r < d.equations.size(); ++r) out.F[rowKey(d.equations[r])] = v.F[r];
   const auto& starts = k.description.jacobianColumnStarts;
   const auto& rows = k.description.jacobianRowIndices;
@@ -67,7 +69,13 @@ Evaluated evaluated(const dae::Dae& d, const kernel::KernelModule& k, int trial,
   return out;
 }
 
+void expectSameOutputs(const std::vector<double>& a, const std::vector<double>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(b[i], a[i], 1e-12 * (1 + std::fabs(a[i]))) << "output " << i;
+}
+
 void expectSame(const Evaluated& a, const Evaluated& b) {
+  expectSameOutputs(a.outputs, b.outputs);
   ASSERT_EQ(a.F.size(), b.F.size());
   for (const auto& [row, value] : a.F) EXPECT_NEAR(b.F.at(row), value, 1e-12 * (1 + std::fabs(value))) << row;
   ASSERT_EQ(a.J.size(), b.J.size()) << "the same Jacobian pattern";
@@ -89,6 +97,7 @@ void expectSameUpToRowOrder(const kernel::KernelModule& a, const kernel::KernelM
     ASSERT_EQ(u.size(), v.size());
     for (size_t i = 0; i < u.size(); ++i) EXPECT_NEAR(v[i], u[i], 1e-12 * (1 + std::fabs(u[i])));
   };
+  expectSameOutputs(x.outputs, y.outputs);
   near(sorted(x.F), sorted(y.F));
   const auto &sa = a.description.jacobianColumnStarts, &sb = b.description.jacobianColumnStarts;
   ASSERT_EQ(sa, sb) << "the same number of entries in each column";
@@ -107,6 +116,12 @@ TEST(RerollRows, AChainOfComponentArraysLoopsWithTheScalarKernelsValues) {
   // kinematic rows: two loops.
   EXPECT_EQ(r.blocks, 2u);
   EXPECT_EQ(r.rows, static_cast<size_t>((n - 2) + n));
+  // The flows the DAE solved out, result columns: links[i].b.f (the link's law), their negatives
+  // ms[i].a.f, the other ends ms[i-1].b.f and links[i].a.f, each run but its first element.
+  EXPECT_EQ(r.outputBlocks, 4u);
+  EXPECT_GE(r.outputs, static_cast<size_t>(4 * (n - 2)));
+  for (const dae::OutputBlock& o : rerolled.outputBlocks)
+    for (int i = o.first; i < o.first + o.count; ++i) EXPECT_EQ(rerolled.outputs[i].value, nullptr);
   ASSERT_EQ(rerolled.templateBlocks.size(), r.blocks);
   for (const dae::TemplateBlock& b : rerolled.templateBlocks)
     for (int row = b.firstRow; row < b.firstRow + static_cast<int>(flat::pointCount(b.region)); ++row)
@@ -118,6 +133,8 @@ TEST(RerollRows, AChainOfComponentArraysLoopsWithTheScalarKernelsValues) {
   ASSERT_FALSE(diags.hasErrors());
   EXPECT_EQ(test::loopCount(a.program(ModelProgram::Residual)), 0u);
   EXPECT_EQ(test::loopCount(b.program(ModelProgram::Residual)), 2u);
+  EXPECT_EQ(test::loopCount(b.program(ModelProgram::Outputs)), 4u);
+  EXPECT_EQ(a.description.outputNames, b.description.outputNames) << "the same columns, in the same order";
   EXPECT_LT(b.program(ModelProgram::Residual).code.size(), a.program(ModelProgram::Residual).code.size() / 5);
   EXPECT_EQ(a.description.parameterNames.size(), b.description.parameterNames.size());
   for (int trial = 0; trial < 3; ++trial) expectSame(evaluated(scalar, a, trial), evaluated(rerolled, b, trial));
@@ -170,8 +187,9 @@ namespace qdot {
 namespace {
 
 // Every example and simulation-test model, compiled as `qdot run` compiles it, with rerolling at
-// runs of two rows (so that small models reroll too): where rows were rerolled, the kernels give
-// the values of the same model compiled without rerolling, row by row, entry by entry.
+// runs of two rows or outputs (so that small models reroll too): where some were rerolled, the
+// kernels give the values of the same model compiled without rerolling, row by row, entry by
+// entry, output by output.
 TEST(RerollRows, EveryModelRerolledEvenByTwoRowsKeepsItsValues) {
   namespace fs = std::filesystem;
   std::vector<fs::path> files;
@@ -190,7 +208,7 @@ TEST(RerollRows, EveryModelRerolledEvenByTwoRowsKeepsItsValues) {
     driver::Compilation plain, looped;
     if (!compile(plain, false)) continue;  // (models that are meant to fail)
     ASSERT_TRUE(compile(looped, true)) << file;
-    if (looped.rerolled.blocks == 0) continue;
+    if (looped.rerolled.blocks == 0 && looped.rerolled.outputBlocks == 0) continue;
     ++rerolled;
     SCOPED_TRACE(file.string());
     std::set<std::string> keys;
