@@ -45,7 +45,9 @@ class Reroller {
 
   RerollResult run() {
     RerollResult result;
-    if (d_.templated() || !d_.differentiatedRows.empty()) return result;
+    // Initial equations may become rows used at t0 whose plan (dae::planInitialization) reads every
+    // row's residual: such a model keeps its rows.
+    if (d_.templated() || !d_.differentiatedRows.empty() || !d_.initialEquations.empty()) return result;
     indexSymbols();
     rerollRowRuns(result);
     rerollOutputRuns(result);

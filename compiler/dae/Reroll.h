@@ -24,8 +24,8 @@ struct RerollResult {
 /// one at a constant stride), and makes each a TemplateBlock: its rows are moved next to each other
 /// (the derivative links and the Euler–Lagrange rows' coordinates move with them), its parameters
 /// made consecutive in `parameters` where a stride separated them. The DAE must be scalar (no
-/// template blocks) and of index 1 (no differentiated rows); otherwise, or if nothing repeats,
-/// it is left as it was. Then the same for runs of consecutive outputs (their order is the result
+/// template blocks), of index 1 (no differentiated rows) and without initial equations; otherwise,
+/// or if nothing repeats, it is left as it was. Then the same for runs of consecutive outputs (their order is the result
 /// columns', so it is kept), along the unknowns and parameters that are consecutive: OutputBlocks.
 RerollResult rerollRows(Dae& dae, sym::Context& ctx, size_t minimumRun = 16);
 

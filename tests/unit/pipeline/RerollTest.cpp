@@ -224,3 +224,26 @@ TEST(RerollRows, EveryModelRerolledEvenByTwoRowsKeepsItsValues) {
 
 }  // namespace
 }  // namespace qdot
+
+namespace qdot {
+namespace {
+
+// Three equal oscillators (rows that repeat, by two) with an initial equation that is not a start
+// value: its row at t0 is planned over every row's residual, so the rows stay rows. (Found by the
+// pipeline fuzzer: rerolled rows have no residual of their own.)
+TEST(RerollRows, AModelWithInitialEquationsKeepsItsRows) {
+  driver::Compilation c;
+  c.options.keepLoops = c.options.eliminateAlgebraics = c.options.rerollRows = true;
+  c.options.rerollMinimumRun = 2;
+  ASSERT_TRUE(driver::compileSource(c, "init.qd",
+                                    "model Init\n  coordinate Real x(start = 1, fixed = true);\n  coordinate Real y;\n"
+                                    "  coordinate Real z(start = 0.5, fixed = false);\nmechanics\n"
+                                    "  kinetic = 0.5*der(x)^2 + 0.5*der(y)^2 + 0.5*der(z)^2;\n"
+                                    "  potential = 0.5*x^2 + 0.5*y^2 + 0.5*z^2;\ninitial equation\n  der(der(z)) = 0.25;\nend Init;\n",
+                                    driver::Stage::Kernel));
+  EXPECT_EQ(c.rerolled.blocks, 0u);
+  EXPECT_FALSE(c.dae->templated());
+}
+
+}  // namespace
+}  // namespace qdot
