@@ -13,7 +13,8 @@ Prints a markdown table (time per stage, file to first step, peak memory, both p
 side) and the fitted exponent of each column between consecutive sizes (t ~ n^k).
 
 Then the ways of writing repeated structure (FORMS: energies with arrays of parameters, `for`
-equations with implicit rows or algebraic unknowns) as templates against expanded to scalars.
+equations with implicit rows or algebraic unknowns, arrays of components, whose rows are rerolled)
+as templates against expanded to scalars (--no-loops, which also leaves rows unrerolled).
 
 Then the whole process at issue 15's setting (rtol 1e-6, 1 s, KLU, columns x[1] and x[n]) for
 n = 10^3 ... 10^5 (--whole-sizes): `qdot run` in its default mode (tiering) against the hand-written
@@ -126,7 +127,9 @@ FORMS = [("spring chain, energies", CHAIN, "x[1]"),
          ("damped chain, energy and power as outputs of sums", "tests/sim/models/chain_energy_outputs.qd", "E,P"),
          ("chain through definitions and factors (`kinetic = T`, `0.5*m*sum(…)`)",
           "tests/sim/models/chain_definitions.qd", "E,P"),
-         ("chain, energies and forces in `for` loops", "tests/sim/models/chain_for_energies.qd", "x[1]")]
+         ("chain, energies and forces in `for` loops", "tests/sim/models/chain_for_energies.qd", "x[1]"),
+         ("chain of `Vibration` parts (arrays of components): expanded, rows rerolled",
+          "tests/sim/models/chain_components.qd", "ms[1].s")]
 
 
 def forms(build, n, repeat):
