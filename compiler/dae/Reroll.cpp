@@ -1,14 +1,16 @@
-// Rerolling (Reroll.h): each row's residual is written over placeholders for its symbols, taken in
-// symbol order, so that rows which are one expression over other symbols share one node (the
-// skeleton; hash-consing makes comparing them a pointer comparison). Rows with one skeleton, in row
-// order, form runs where every placeholder stands for the same symbol in each row (a parameter, the
-// time) or moves by a constant stride: +1 along the unknowns, any stride along the parameters. A
-// long enough run becomes a TemplateBlock whose relative symbols index arrays made of the symbols
-// the placeholders stood for, row by row.
+// Rerolling (Reroll.h): each row's residual is read with its symbols replaced by their places
+// (slots, taken in symbol order), so that rows which are one expression over other symbols have one
+// signature (a structural hash over kinds, numbers and slots), confirmed by walking the two
+// expressions side by side. Rows with one signature, in row order, form runs where every slot
+// stands for the same symbol in each row (a parameter, the time) or moves by a constant stride: +1
+// along the unknowns, any stride along the parameters. A long enough run becomes a TemplateBlock
+// whose relative symbols index arrays made of the symbols the slots stood for, row by row. (Nothing
+// is built per row: a model of 10⁵ elements has 6·10⁵ rows and outputs to look at.)
 #include "dae/Reroll.h"
 
 #include <algorithm>
 #include <climits>
+#include <cstring>
 #include <map>
 #include <tuple>
 #include <optional>
@@ -21,7 +23,7 @@ using sym::Expr;
 
 enum class Space : uint8_t { Unknown, Rate, Parameter, Other };
 
-// What a placeholder of a row stands for: an unknown's y or y' (by variable), a parameter, or
+// What a slot of a row stands for: an unknown's y or y' (by variable), a parameter, or
 // another symbol (the time), which must then be the same in every row of a run.
 struct Slot {
   Space space = Space::Other;
@@ -30,7 +32,8 @@ struct Slot {
 };
 
 struct RowShape {
-  Expr skeleton = nullptr;
+  Expr value = nullptr;     ///< null: not looked at
+  uint64_t signature = 0;  ///< equal for rows that are one expression over their slots
   std::vector<Slot> slots;
 };
 
@@ -70,7 +73,7 @@ class Reroller {
   }
 
   // Outputs keep their order (it is the result columns'): runs of consecutive outputs of one
-  // skeleton and kind, along the unknowns and along parameters already consecutive, become
+  // signature and kind, along the unknowns and along parameters already consecutive, become
   // OutputBlocks (a component array's flows, which the DAE solved out of the system).
   void rerollOutputRuns(RerollResult& result) {
     if (d_.outputs.size() < minimum_) return;
@@ -79,7 +82,7 @@ class Reroller {
     for (size_t i = 0; i < d_.outputs.size(); ++i)
       if (d_.outputs[i].value && d_.outputs[i].sums.empty()) shapes[i] = shapeOf(d_.outputs[i].value);
     auto follows = [&](size_t a, size_t b) -> std::optional<std::vector<long>> {
-      if (!shapes[a].skeleton || shapes[a].skeleton != shapes[b].skeleton || d_.outputs[a].kind != d_.outputs[b].kind)
+      if (!shapes[a].value || shapes[a].signature != shapes[b].signature || d_.outputs[a].kind != d_.outputs[b].kind)
         return std::nullopt;
       return strides(shapes[a], shapes[b], 1);
     };
@@ -118,7 +121,7 @@ class Reroller {
     where_[symbol->symbolId] = {space, static_cast<long>(index)};
   }
 
-  // The rows worth a skeleton: those among at least `minimum_` rows of one origin whose residuals
+  // The rows worth a signature: those among at least `minimum_` rows of one origin whose residuals
   // agree in what a node tells at once (kind, operand count, depth). Cheap, so that a model with
   // nothing repeated (the N-link pendulum's dense rows) pays next to nothing.
   std::vector<int> candidateRows() const {
@@ -135,37 +138,106 @@ class Reroller {
 
   flat::OriginKind kindOf(const Run& r) const { return d_.equations[r.rows[0]].origin.kind; }
 
-  Expr placeholder(size_t k) {
-    while (placeholders_.size() <= k) placeholders_.push_back(ctx_.symbol("$r" + std::to_string(placeholders_.size())));
-    return placeholders_[k];
-  }
 
   RowShape shapeOf(Expr value) {
     RowShape s;
     if (!value) return s;
+    s.value = value;
     std::vector<Expr> symbols = ctx_.freeSymbols(value);
     std::sort(symbols.begin(), symbols.end(), [](Expr a, Expr b) { return a->symbolId < b->symbolId; });
-    std::unordered_map<Expr, Expr>& map = placeholderMap_;
-    map.clear();
     for (size_t k = 0; k < symbols.size(); ++k) {
       uint32_t id = symbols[k]->symbolId;
       Slot slot = id < where_.size() ? Slot{where_[id].first, where_[id].second} : Slot{};
       slot.symbol = symbols[k];
       s.slots.push_back(slot);
-      map.emplace(symbols[k], placeholder(k));
     }
-    s.skeleton = ctx_.substitute(value, map);
+    s.signature = signatureOf(s);
     return s;
+  }
+
+  // Slot numbers of a shape's symbols, by symbol id, in one of two scratch tables (set, used, reset).
+  void setSlots(std::vector<int32_t>& table, const RowShape& s) {
+    for (size_t k = 0; k < s.slots.size(); ++k) {
+      uint32_t id = s.slots[k].symbol->symbolId;
+      if (table.size() <= id) table.resize(id + 1, -1);
+      table[id] = static_cast<int32_t>(k);
+    }
+  }
+  static void resetSlots(std::vector<int32_t>& table, const RowShape& s) {
+    for (const Slot& slot : s.slots) table[slot.symbol->symbolId] = -1;
+  }
+
+  static uint64_t mix(uint64_t h, uint64_t v) { return (h ^ (v + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2))) * 0x100000001b3ull; }
+  static uint64_t bits(double v) {
+    uint64_t b;
+    std::memcpy(&b, &v, sizeof b);
+    return b;
+  }
+
+  // A hash of the expression with each symbol read as its slot: the DAG walked once (children
+  // before parents, each node once).
+  uint64_t signatureOf(const RowShape& s) {
+    setSlots(slotA_, s);
+    hashes_.clear();
+    std::vector<std::pair<Expr, size_t>> stack{{s.value, 0}};
+    while (!stack.empty()) {
+      auto& [n, next] = stack.back();
+      size_t kids = n->args.size() + n->exps.size();
+      if (next < kids) {
+        Expr c = next < n->args.size() ? n->args[next] : n->exps[next - n->args.size()];
+        ++next;
+        if (!hashes_.count(c)) stack.push_back({c, 0});
+        continue;
+      }
+      uint64_t h = mix(static_cast<uint64_t>(n->kind), bits(n->value));
+      if (n->isSymbol()) h = mix(h, static_cast<uint64_t>(slotA_[n->symbolId]) + 1);
+      for (double c : n->coefs) h = mix(h, bits(c));
+      for (Expr c : n->args) h = mix(h, hashes_.at(c));
+      for (Expr c : n->exps) h = mix(h, hashes_.at(c));
+      hashes_.emplace(n, h);
+      stack.pop_back();
+    }
+    resetSlots(slotA_, s);
+    return hashes_.at(s.value);
+  }
+
+  // Whether two shapes with one signature are one expression over their slots: walked side by side.
+  bool sameExpression(const RowShape& x, const RowShape& y) {
+    if (x.slots.size() != y.slots.size()) return false;
+    setSlots(slotA_, x);
+    setSlots(slotB_, y);
+    pairs_.clear();
+    std::vector<std::pair<Expr, Expr>> stack{{x.value, y.value}};
+    bool same = true;
+    while (same && !stack.empty()) {
+      auto [a, b] = stack.back();
+      stack.pop_back();
+      auto [at, fresh] = pairs_.try_emplace(a, b);
+      if (!fresh) {
+        same = at->second == b;
+        continue;
+      }
+      same = a->kind == b->kind && bits(a->value) == bits(b->value) && a->args.size() == b->args.size() &&
+             a->exps.size() == b->exps.size() && a->coefs.size() == b->coefs.size() &&
+             std::equal(a->coefs.begin(), a->coefs.end(), b->coefs.begin(), [](double u, double v) { return bits(u) == bits(v); }) &&
+             (!a->isSymbol() || slotA_[a->symbolId] == slotB_[b->symbolId]);
+      for (size_t k = 0; same && k < a->args.size(); ++k) stack.push_back({a->args[k], b->args[k]});
+      for (size_t k = 0; same && k < a->exps.size(); ++k) stack.push_back({a->exps[k], b->exps[k]});
+    }
+    resetSlots(slotA_, x);
+    resetSlots(slotB_, y);
+    return same;
   }
 
   // How each slot moves from row a to row b, if b may follow a in a run: the same symbol, or for an
   // unknown the next one, for a parameter one at any distance after it. An unknown that stays the
   // same in every row is not taken (a loop reads unknowns only through arrays).
-  std::optional<std::vector<long>> strides(int a, int b) const {
+  std::optional<std::vector<long>> strides(int a, int b) {
     if (d_.equations[a].origin.kind != d_.equations[b].origin.kind) return std::nullopt;
     return strides(shapes_[a], shapes_[b]);
   }
-  static std::optional<std::vector<long>> strides(const RowShape& x, const RowShape& y, long parameterStride = LONG_MAX) {
+  std::optional<std::vector<long>> strides(const RowShape& x, const RowShape& y, long parameterStride = LONG_MAX) {
+    if (x.signature != y.signature || !sameExpression(x, y)) return std::nullopt;
     std::vector<long> out(x.slots.size());
     bool moves = false;
     for (size_t k = 0; k < x.slots.size(); ++k) {
@@ -192,18 +264,18 @@ class Reroller {
     return out;
   }
 
-  std::vector<Run> findRuns() const {
-    std::unordered_map<Expr, std::vector<int>> bySkeleton;
-    std::vector<Expr> order;  // skeletons by first row: runs come out in row order
+  std::vector<Run> findRuns() {
+    std::unordered_map<uint64_t, std::vector<int>> bySignature;
+    std::vector<uint64_t> order;  // signatures by first row: runs come out in row order
     for (size_t r = 0; r < shapes_.size(); ++r) {
-      if (!shapes_[r].skeleton) continue;
-      auto [at, fresh] = bySkeleton.try_emplace(shapes_[r].skeleton);
-      if (fresh) order.push_back(shapes_[r].skeleton);
+      if (!shapes_[r].value) continue;
+      auto [at, fresh] = bySignature.try_emplace(shapes_[r].signature);
+      if (fresh) order.push_back(shapes_[r].signature);
       at->second.push_back(static_cast<int>(r));
     }
     std::vector<Run> runs;
-    for (Expr skeleton : order) {
-      const std::vector<int>& rows = bySkeleton[skeleton];
+    for (uint64_t signature : order) {
+      const std::vector<int>& rows = bySignature[signature];
       for (size_t i = 0; i + 1 < rows.size();) {
         std::optional<std::vector<long>> step = strides(rows[i], rows[i + 1]);
         if (!step) {
@@ -358,8 +430,9 @@ class Reroller {
   size_t minimum_;
   std::vector<std::pair<Space, long>> where_;  ///< by symbolId: what each symbol of the DAE is
   std::vector<RowShape> shapes_;
-  std::vector<Expr> placeholders_;
-  std::unordered_map<Expr, Expr> placeholderMap_;  ///< shapeOf's, kept to spare an allocation per row
+  std::vector<int32_t> slotA_, slotB_;          ///< by symbol id: its slot in the shapes looked at (-1: none)
+  std::unordered_map<Expr, uint64_t> hashes_;   ///< signatureOf's, kept to spare an allocation per row
+  std::unordered_map<Expr, Expr> pairs_;        ///< sameExpression's
   std::unordered_map<std::string, int> arrays_;
 };
 
