@@ -230,8 +230,7 @@ class Reroller {
   }
 
   // How each slot moves from row a to row b, if b may follow a in a run: the same symbol, or for an
-  // unknown the next one, for a parameter one at any distance after it. An unknown that stays the
-  // same in every row is not taken (a loop reads unknowns only through arrays).
+  // unknown the next one, for a parameter one at any distance after it.
   std::optional<std::vector<long>> strides(int a, int b) {
     if (d_.equations[a].origin.kind != d_.equations[b].origin.kind) return std::nullopt;
     return strides(shapes_[a], shapes_[b]);
@@ -251,7 +250,7 @@ class Reroller {
           break;
         case Space::Unknown:
         case Space::Rate:
-          if (step != 1) return std::nullopt;
+          if (step != 0 && step != 1) return std::nullopt;
           break;
         case Space::Parameter:
           if (step < 0 || step > parameterStride) return std::nullopt;
@@ -286,12 +285,28 @@ class Reroller {
         size_t j = i + 2;
         for (; j < rows.size() && strides(rows[j - 1], rows[j]) == run.strides; ++j) run.rows.push_back(rows[j]);
         // A run kept owns its rows; a short one's last row may still start the next run.
-        bool kept = run.rows.size() >= minimum_;
+        bool kept = run.rows.size() >= minimum_ && commonUnknownsApart(run);
         if (kept) runs.push_back(std::move(run));
         i = kept ? j : j - 1;
       }
     }
     return runs;
+  }
+
+  // An unknown every row of a run reads (a common frame) is a Jacobian column of its own in each
+  // row: it must not be one the arrays of the run reach (that row would have the column twice).
+  bool commonUnknownsApart(const Run& r) const {
+    const std::vector<Slot>& first = shapes_[r.rows[0]].slots;
+    auto n = static_cast<long>(r.rows.size());
+    for (size_t k = 0; k < first.size(); ++k) {
+      bool unknown = first[k].space == Space::Unknown || first[k].space == Space::Rate;
+      if (!unknown || r.strides[k] != 0) continue;
+      for (size_t m = 0; m < first.size(); ++m) {
+        bool moving = (first[m].space == Space::Unknown || first[m].space == Space::Rate) && r.strides[m] != 0;
+        if (moving && first[k].index >= first[m].index && first[k].index < first[m].index + n) return false;
+      }
+    }
+    return true;
   }
 
   // A loop reads a parameter array as p[first + i]: the parameters a run reads at a stride of more

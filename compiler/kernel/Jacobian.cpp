@@ -213,21 +213,27 @@ std::vector<TemplateOperand> LoopOperands::read(const std::vector<int>& shape, c
 
 namespace {
 
-// The entries of block b: ∂F/∂y + cj ∂F/∂y' per column pattern (positions are sized, not yet given).
+// The entries of block b: ∂F/∂y + cj ∂F/∂y' per column pattern (positions are sized, not yet
+// given): the relative symbols' (the operands), then the unknowns the rows read as themselves.
 void templateEntries(const dae::Dae& dae, sym::Context& ctx, sym::Expr cj, size_t b, std::span<const TemplateOperand> operands,
-                     std::vector<TemplateEntry>& out) {
+                     const UnknownSymbols& unknowns, std::vector<TemplateEntry>& out) {
   const dae::TemplateBlock& block = dae.templateBlocks[b];
   size_t first = out.size();
-  for (const TemplateOperand& op : operands) {
-    if (op.parameter) continue;
-    sym::Expr d = ctx.diff(block.residual, op.symbol);
-    if (d->isZero()) continue;
-    if (op.derivative) d = ctx.mul(cj, d);
-    auto same = std::find_if(out.begin() + static_cast<long>(first), out.end(),
-                             [&](const TemplateEntry& e) { return e.variable == op.variable && e.offset == op.offset; });
+  auto add = [&](sym::Expr symbol, bool derivative, int variable, long offset, bool fixed) {
+    sym::Expr d = ctx.diff(block.residual, symbol);
+    if (d->isZero()) return;
+    if (derivative) d = ctx.mul(cj, d);
+    auto same = std::find_if(out.begin() + static_cast<long>(first), out.end(), [&](const TemplateEntry& e) {
+      return e.fixed == fixed && e.variable == variable && e.offset == offset;
+    });
     if (same != out.end()) same->value = ctx.add(same->value, d);
-    else out.push_back({static_cast<int>(b), d, op.variable, op.offset, {}});
-  }
+    else out.push_back({static_cast<int>(b), d, variable, offset, {}, fixed});
+  };
+  for (const TemplateOperand& op : operands)
+    if (!op.parameter) add(op.symbol, op.derivative, op.variable, op.offset, false);
+  for (sym::Expr s : ctx.freeSymbols(block.residual))
+    if (std::optional<UnknownSymbols::Unknown> u = unknowns.find(s))
+      add(s, u->derivative, static_cast<int>(u->variable), 0, true);
   for (size_t e = first; e < out.size(); ++e) out[e].positions.resize(flat::pointCount(block.region));
 }
 
@@ -271,7 +277,7 @@ class PatternLayout {
       long at = row - dae_.templateBlocks[b].firstRow;
       for (size_t e = entriesOf_[b]; e < entriesOf_[b + 1]; ++e) {
         TemplateEntry& t = J_.templateEntries[e];
-        t.positions[c] = place(row, static_cast<int32_t>(t.variable + at + t.offset));
+        t.positions[c] = place(row, t.column(at));
       }
     }
     J_.scalarEntries = inPositionOrder(scalar, position);
@@ -288,7 +294,7 @@ class PatternLayout {
         long at = flat::linearIndex(block.shape, p);
         for (size_t e = entriesOf_[b]; e < entriesOf_[b + 1]; ++e) {
           const TemplateEntry& t = J_.templateEntries[e];
-          ++starts[t.variable + at + t.offset + 1];
+          ++starts[t.column(at) + 1];
         }
       });
     }
@@ -319,7 +325,8 @@ JacobianEntries differentiate(const dae::Dae& dae, const UnknownSymbols& unknown
   LoopOperands operands(dae, ctx, unknowns);
   for (const dae::TemplateBlock& block : dae.templateBlocks)
     J.templateOperands.push_back(operands.read(block.shape, block.region, block.residual));
-  for (size_t b = 0; b < dae.templateBlocks.size(); ++b) templateEntries(dae, ctx, cj, b, J.templateOperands[b], J.templateEntries);
+  for (size_t b = 0; b < dae.templateBlocks.size(); ++b)
+    templateEntries(dae, ctx, cj, b, J.templateOperands[b], unknowns, J.templateEntries);
   PatternLayout(dae, J).run(scalar);
   return J;
 }

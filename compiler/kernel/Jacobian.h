@@ -43,14 +43,18 @@ class LoopOperands {
 };
 
 /// One entry of a template block's rows: the value (over the block's relative symbols and cj) at
-/// column variable + linear(row's subscripts) + offset, and its CSC position per point of the
-/// block's region (row-major order, the order of the loop).
+/// column variable + linear(row's subscripts) + offset — or, `fixed`, at column `variable` in every
+/// row (an unknown the rows read as itself, a rerolled run's common unknown) — and its CSC position
+/// per point of the block's region (row-major order, the order of the loop).
 struct TemplateEntry {
   int block = -1;
   sym::Expr value = nullptr;
   int variable = -1;
   long offset = 0;
   std::vector<uint32_t> positions;
+  bool fixed = false;
+
+  int32_t column(long at) const { return static_cast<int32_t>(fixed ? variable : variable + at + offset); }
 };
 
 /// One entry of a row that is not a template's: its CSC position, its row and its value.

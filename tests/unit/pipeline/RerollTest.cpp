@@ -153,19 +153,27 @@ TEST(RerollRows, ShortRunsStayRows) {
   EXPECT_EQ(dae::rerollRows(d, model.c.ctx, 8).blocks, 2u) << "a lower minimum takes them";
 }
 
-// Every row reads one common unknown (the frame position y): a loop reads unknowns only through
-// arrays, so the rows stay scalar. (Compiled without loops: the model is expanded to scalars.)
-TEST(RerollRows, RowsReadingOneCommonUnknownStayRows) {
+// Every row of x reads one common unknown (the frame position y): in the loop it is a column of its
+// own in each row (kernel::TemplateEntry::fixed), the same pattern and values as the scalar rows.
+TEST(RerollRows, RowsReadingOneCommonUnknownLoopWithItsColumn) {
   driver::Compilation c;
+  c.options.eliminateAlgebraics = true;
   ASSERT_TRUE(driver::compileSource(c, "m.qd",
                                     "model M\n  parameter Integer n = 30;\n  coordinate Real x[n](start = {0.01*i for i in 1:n});\n"
                                     "  coordinate Real y(start = 0.1);\nmechanics\n"
                                     "  kinetic = sum(0.5*der(x[i])^2 for i in 1:n) + 0.5*der(y)^2;\n"
-                                    "  potential = sum(0.5*(x[i] - y)^2 for i in 1:n) + 0.5*y^2;\nend M;\n",
+                                    "  potential = sum(0.5*(x[i] - y)^2 + 0.1*(x[i] - y)^4 for i in 1:n) + 0.5*y^2;\n"
+                                    "  dissipation = sum(0.05*(der(x[i]) - der(y))^2 for i in 1:n);\nend M;\n",
                                     driver::Stage::Dae));
-  dae::Dae d = *c.dae;
-  dae::RerollResult r = dae::rerollRows(d, c.ctx);
-  EXPECT_EQ(r.blocks, 0u) << "the rows of x read y, the kinematic rows alone are not worth a loop";
+  dae::Dae scalar = *c.dae, rerolled = *c.dae;
+  dae::RerollResult r = dae::rerollRows(rerolled, c.ctx);
+  EXPECT_EQ(r.blocks, 2u) << "the rows of x, and the kinematic rows";
+  EXPECT_EQ(r.rows, 30u + 31u) << "y, the unknown after x[30], has a kinematic row like theirs";
+  DiagnosticEngine diags;
+  kernel::KernelModule a = kernel::buildKernels(scalar, c.ctx, diags);
+  kernel::KernelModule b = kernel::buildKernels(rerolled, c.ctx, diags);
+  ASSERT_FALSE(diags.hasErrors());
+  for (int trial = 0; trial < 3; ++trial) expectSame(evaluated(scalar, a, trial), evaluated(rerolled, b, trial));
 }
 
 // `qdot run`'s pipeline: a chain of components of 40 masses is rerolled, and says so.
