@@ -66,6 +66,10 @@ class Reroller {
     // Kinematic rows (q' = der(q): one subtraction each) are not worth loops on their own: the
     // N-link pendulum's would only make its kernel a little slower to build.
     if (std::all_of(runs.begin(), runs.end(), [&](const Run& r) { return kindOf(r) == flat::OriginKind::Kinematic; })) return;
+    // The Euler–Lagrange rows are the first rowCoordinates.size() rows and stay so: a run on both
+    // sides of that line (there is none in a DAE as built) is left as rows.
+    auto m = static_cast<int>(d_.rowCoordinates.size());
+    std::erase_if(runs, [&](const Run& r) { return (r.rows.front() < m) != (r.rows.back() < m); });
     makeParametersConsecutive(runs);
     if (runs.empty()) return;
     moveRowsTogether(runs);
