@@ -100,11 +100,6 @@ bool loopsRead(const flat::FlatModel& m, sym::Expr body, size_t rank, const std:
   return true;
 }
 
-bool loopsReadForce(const flat::FlatModel& m, const flat::IndexedForce& f, const sym::Context& ctx) {
-  const std::vector<int>* shape = &m.patterns->arrays[m.relativeElement(f.target)->array].shape;
-  return loopsRead(m, f.body, f.box.size(), shape, ctx);
-}
-
 // A templated model's outputs: each sum a loop reads (over coordinates or velocities, see
 // loopsRead) takes their shape and stays a loop; the others (over parameters or the iterator only)
 // are expanded into the output's value.

@@ -36,15 +36,15 @@ using kernel::Op;
 enum Arg : unsigned { kCall, kOut, kSpill, kArgCount };
 
 /// The fields of qdot::ModelCall, in declaration order (the LLVM struct below mirrors its layout).
-enum CallField : unsigned { kTime, kCj, kY, kYp, kP, kGiven, kOverridden };
+enum CallField : unsigned { kTime, kCj, kY, kYp, kP, kGiven, kOverridden, kIndexTable };
 static_assert(offsetof(ModelCall, t) == 0 && offsetof(ModelCall, cj) == 8 && offsetof(ModelCall, y) == 16 &&
-                  offsetof(ModelCall, overridden) == 48 && sizeof(ModelCall) == 56,
-              "the generated code reads qdot::ModelCall as {double, double, ptr x 5}");
+                  offsetof(ModelCall, overridden) == 48 && offsetof(ModelCall, indexTable) == 56 && sizeof(ModelCall) == 64,
+              "the generated code reads qdot::ModelCall as {double, double, ptr x 6}");
 
 llvm::StructType* callType(llvm::LLVMContext& c) {
   auto* ptr = llvm::PointerType::getUnqual(c);
   auto* dbl = llvm::Type::getDoubleTy(c);
-  return llvm::StructType::get(c, {dbl, dbl, ptr, ptr, ptr, ptr, ptr});
+  return llvm::StructType::get(c, {dbl, dbl, ptr, ptr, ptr, ptr, ptr, ptr});
 }
 
 llvm::Function* declareProgramFunction(llvm::Module& m, const std::string& name, bool internal) {
@@ -70,7 +70,7 @@ llvm::Function* declareProgramFunction(llvm::Module& m, const std::string& name,
 class PartLowering {
  public:
   PartLowering(const kernel::Program& p, const ProgramSplit& split, llvm::Function* f, size_t begin, size_t end,
-               IndexTables tables = IndexTables::Embedded)
+               IndexTables tables = IndexTables::FromCall)
       : prog_(p), split_(split), mod_(*f->getParent()), b_(f->getContext()), dbl_(b_.getDoubleTy()), fn_(f),
         begin_(begin), end_(end), local_(end - begin, nullptr), tables_(tables) {}
 
@@ -151,8 +151,8 @@ class PartLowering {
     b_.CreateCondBr(b_.CreateICmpULT(next, b_.getInt64(count_)), body_, after);
     b_.SetInsertPoint(after);
   }
-  // X[base + c] as an i64: from the index table, a private constant global of the module (one per
-  // program), or the program's own table at its address (IndexTables::InPlace).
+  // X[base + c] as an i64: from the index table the call points to, or the program's own table at
+  // its address (IndexTables::InPlace).
   llvm::Value* tableEntry(uint32_t base) {
     llvm::Type* i32 = b_.getInt32Ty();
     llvm::Value* at = b_.CreateInBoundsGEP(i32, indexTable(), b_.CreateAdd(b_.getInt64(base), c_));
@@ -163,14 +163,7 @@ class PartLowering {
       auto address = reinterpret_cast<uint64_t>(prog_.indexTable.data());
       return llvm::ConstantExpr::getIntToPtr(b_.getInt64(address), b_.getPtrTy());
     }
-    auto* type = llvm::ArrayType::get(b_.getInt32Ty(), prog_.indexTable.size());
-    std::string name = "qdot.X." + prog_.name;
-    llvm::GlobalVariable* table = mod_.getNamedGlobal(name);
-    if (!table || table->getValueType() != type) {
-      auto* init = llvm::ConstantDataArray::get(mod_.getContext(), llvm::ArrayRef<uint32_t>(prog_.indexTable));
-      table = new llvm::GlobalVariable(mod_, type, true, llvm::GlobalValue::PrivateLinkage, init, name);
-    }
-    return table;
+    return callField(kIndexTable);
   }
   // &array[imm + L] of a looped load or store.
   llvm::Value* loopedPtr(llvm::Value* array, uint32_t imm) {
@@ -302,7 +295,7 @@ class PartLowering {
   std::vector<llvm::Value*> local_;                       // values of [begin_, end_)
   IndexTables tables_;
   std::unordered_map<uint32_t, llvm::Value*> imported_;  // earlier parts' values used here
-  std::array<llvm::Value*, kOverridden + 1> fields_{};    // ModelCall fields loaded in this part
+  std::array<llvm::Value*, kIndexTable + 1> fields_{};    // ModelCall fields loaded in this part
   llvm::BasicBlock* entry_ = nullptr;
   // The open loop: its body block, the iteration phi, its offset in this iteration, its count.
   llvm::BasicBlock* body_ = nullptr;

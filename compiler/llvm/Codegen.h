@@ -20,18 +20,18 @@ class Module;
 
 namespace qdot::llvmbackend {
 
-/// Where compiled loops find a program's index table (kernel::Program::indexTable): a constant of
-/// the module (object files), or the table itself, read in place at its address — for the JIT,
-/// whose code never outlives the KernelModule it was compiled from, so that a table of millions
-/// of Jacobian positions is neither copied nor turned into machine-code data (JIT time would grow
-/// with n).
-enum class IndexTables { Embedded, InPlace };
+/// Where compiled loops find a program's index table (kernel::Program::indexTable): through the
+/// call (ModelCall::indexTable: object files, whose executable holds the table in its embedded
+/// module), or read in place at its address — for the JIT, whose code never outlives the
+/// KernelModule it was compiled from. Either way a table of millions of Jacobian positions is not
+/// machine-code data: JIT time and executable size would grow with n.
+enum class IndexTables { FromCall, InPlace };
 
 /// Emits parts [first, last) of `p` into `m`, part k as the function `partName(name, k)` with the
 /// ProgramFn signature (Jit.h) and the given linkage. Running parts 0..parts-1 in order, with one
 /// spill array of `split.spillSlots` doubles, computes the program.
 void lowerParts(const kernel::Program& p, const ProgramSplit& split, uint32_t first, uint32_t last,
-                const std::string& name, llvm::Module& m, bool internal, IndexTables tables = IndexTables::Embedded);
+                const std::string& name, llvm::Module& m, bool internal, IndexTables tables = IndexTables::FromCall);
 
 /// The LLVM module of a whole KernelModule (for object files): one external entry per program.
 struct LoweredModule {

@@ -19,11 +19,14 @@ struct NativeModel : AdaptedModel {
   ModelDescription description;  // names and pattern the table points into
   ModelPtr vm;                   // the same module on the VM, for the diagnosis of failures
   PerProgram<qdot_program_fn> programs{};
+  PerProgram<std::vector<uint32_t>> indexTables;  // the native code reads them through the call
   mutable PerProgram<std::vector<double>> spill;
 
   int run(ModelProgram program, const ModelCall& c, double* out) const {
     size_t i = programIndex(program);
-    programs[i](&c, out, spill[i].data());
+    ModelCall call = c;
+    call.indexTable = indexTables[i].data();
+    programs[i](&call, out, spill[i].data());
     size_t count = description.outputCount(program);
     if (std::all_of(out, out + count, [](double x) { return std::isfinite(x); })) return 0;
     std::vector<double> scratch(count);  // the VM fails the same way and says where
@@ -40,6 +43,7 @@ Result<ModelPtr> createNativeModel(std::span<const uint8_t> bytes, const qdot_pr
   if (!module) return Error{module.error()};
   auto m = std::make_unique<NativeModel>();
   m->description = module->description;
+  for (size_t i = 0; i < kModelProgramCount; ++i) m->indexTables[i] = module->functions[i].indexTable;
   Result<ModelPtr> vm = vm::createModel(std::move(module).value());
   if (!vm) return Error{vm.error()};
   m->vm = std::move(vm).value();

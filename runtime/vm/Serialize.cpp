@@ -1,10 +1,14 @@
 // bc::serialize / bc::deserialize: a little-endian byte image of a Module (magic "QDBC", format
-// version, then the fields in declaration order; vectors and strings are prefixed by a u32 count).
+// version, then the fields in declaration order; strings are prefixed by a u32 count). Sequences
+// that grow with the model (names, per-variable flags, the Jacobian pattern, code, index tables,
+// locations) are written as runs (vm/Runs.h), so repeated structure is written once.
 // Reading checks every length against the bytes left and validates the result.
+#include <algorithm>
 #include <bit>
 #include <cstring>
 
 #include "qdot/bytecode.h"
+#include "vm/Runs.h"
 
 namespace qdot::bc {
 namespace {
@@ -24,13 +28,21 @@ class Writer {
     u32(static_cast<uint32_t>(s.size()));
     bytes.insert(bytes.end(), s.begin(), s.end());
   }
-  void strings(const std::vector<std::string>& v) {
-    u32(static_cast<uint32_t>(v.size()));
-    for (const auto& s : v) str(s);
-  }
   template <class T> void words(const std::vector<T>& v) {
-    u32(static_cast<uint32_t>(v.size()));
-    for (T x : v) u32(static_cast<uint32_t>(x));
+    std::vector<uint32_t> values(v.size()), encoded;
+    std::transform(v.begin(), v.end(), values.begin(), [](T x) { return static_cast<uint32_t>(x); });
+    runs::encodeWords(values, encoded);
+    for (uint32_t w : encoded) u32(w);
+  }
+  void strings(const std::vector<std::string>& v) {
+    runs::StringTemplates t = runs::splitStrings(v);
+    u32(static_cast<uint32_t>(t.templates.size()));
+    for (const auto& parts : t.templates) {
+      u32(static_cast<uint32_t>(parts.size()));
+      for (const std::string& part : parts) str(part);
+    }
+    words(t.templateOf);
+    words(t.numbers);
   }
   std::vector<uint8_t> bytes;
 };
@@ -66,14 +78,27 @@ class Reader {
     return need(static_cast<size_t>(n) * minBytes, false) ? n : (ok_ = false, 0);
   }
   std::vector<std::string> strings() {
-    std::vector<std::string> v(count(4));
-    for (auto& s : v) s = str();
+    runs::StringTemplates t;
+    t.templates.resize(count(8));
+    for (auto& parts : t.templates) {
+      parts.resize(count(4));
+      for (std::string& part : parts) part = str();
+    }
+    t.templateOf = words<uint32_t>();
+    t.numbers = words<uint32_t>();
+    std::vector<std::string> v;
+    if (ok_ && !runs::joinStrings(t, v)) ok_ = false;
     return v;
   }
   template <class T> std::vector<T> words() {
-    std::vector<T> v(count(4));
-    for (auto& x : v) x = static_cast<T>(u32());
-    return v;
+    struct Source : runs::WordSource {
+      Reader& r;
+      explicit Source(Reader& reader) : r(reader) {}
+      bool next(uint32_t& w) override { return r.need(4) && (w = r.u32(), true); }
+    } source(*this);
+    std::vector<uint32_t> values;
+    if (!ok_ || !runs::decodeWords(source, values)) return ok_ = false, std::vector<T>{};
+    return std::vector<T>(values.begin(), values.end());
   }
 
  private:
@@ -147,8 +172,9 @@ std::vector<uint8_t> serialize(const Module& m) {
   w.u32(kFormatVersion);
   writeDescription(w, m.description);
   for (const Function& f : m.functions) writeFunction(w, f);
-  w.u32(static_cast<uint32_t>(m.locations.size()));
-  for (const Location& l : m.locations) w.str(l.label), w.str(l.where), w.str(l.text);
+  std::vector<std::string> labels, wheres, texts;
+  for (const Location& l : m.locations) labels.push_back(l.label), wheres.push_back(l.where), texts.push_back(l.text);
+  w.strings(labels), w.strings(wheres), w.strings(texts);
   return std::move(w.bytes);
 }
 
@@ -160,8 +186,9 @@ Result<Module> deserialize(std::span<const uint8_t> bytes) {
   Module m;
   m.description = readDescription(r);
   for (Function& f : m.functions) f = readFunction(r);
-  m.locations.resize(r.count(12));
-  for (Location& l : m.locations) l.label = r.str(), l.where = r.str(), l.text = r.str();
+  std::vector<std::string> labels = r.strings(), wheres = r.strings(), texts = r.strings();
+  if (wheres.size() != labels.size() || texts.size() != labels.size()) return Error{"malformed bytecode module (locations)"};
+  for (size_t k = 0; k < labels.size(); ++k) m.locations.push_back({std::move(labels[k]), std::move(wheres[k]), std::move(texts[k])});
   if (!r.ok() || !r.atEnd()) return Error{r.ok() ? "trailing bytes after the bytecode module" : "truncated bytecode module"};
   if (Status valid = validate(m); !valid) return Error{valid.error()};
   return m;

@@ -168,7 +168,7 @@ struct Location {
 };
 
 /// Version of the serialised form; deserialize refuses any other.
-inline constexpr uint32_t kFormatVersion = 6;
+inline constexpr uint32_t kFormatVersion = 7;
 
 /// A whole model: its description (names, flags, Jacobian pattern) and one function per program.
 struct Module {

@@ -59,6 +59,10 @@ struct ModelCall {
   const double* p = nullptr;
   const double* given = nullptr;
   const uint8_t* overridden = nullptr;
+  /// The program's index table X (loop offsets, Jacobian positions), for code that does not hold
+  /// it itself: an executable's ahead-of-time code reads the table of the embedded module here, so
+  /// that a table of millions of entries is not machine-code data (compiler/llvm/Codegen.h).
+  const uint32_t* indexTable = nullptr;
 };
 
 }  // namespace qdot
