@@ -36,13 +36,15 @@ void lowerParts(const kernel::Program& p, const ProgramSplit& split, uint32_t fi
 /// The LLVM module of a whole KernelModule (for object files): one external entry per program.
 struct LoweredModule {
   std::unique_ptr<llvm::Module> module;
-  PerProgram<std::string> entryNames;  ///< "qdot_residual", ...
+  PerProgram<std::string> entryNames;  ///< "qdot_residual", ...; "" for a program not lowered
   PerProgram<uint32_t> functions{};    ///< parts per program
   PerProgram<uint32_t> spillSlots{};   ///< doubles of spill memory it needs
 };
 
-/// Lowers every program of `k` into a new module in `ctx`: each program's parts become internal
-/// functions called in order by its external entry `qdot_<program>` (a one-part program is its entry).
-LoweredModule lowerKernels(const kernel::KernelModule& k, llvm::LLVMContext& ctx, uint32_t maxInstructions);
+/// Lowers the programs of `k` that `programs` names (bits 1 << programIndex, all by default) into
+/// a new module in `ctx`: each program's parts become internal functions called in order by its
+/// external entry `qdot_<program>` (a one-part program is its entry).
+LoweredModule lowerKernels(const kernel::KernelModule& k, llvm::LLVMContext& ctx, uint32_t maxInstructions,
+                           uint32_t programs = ~0u);
 
 }  // namespace qdot::llvmbackend

@@ -40,7 +40,7 @@ Result<ObjectFileInfo> emitObjectFile(const kernel::KernelModule& k, int optLeve
   auto tm = jtmb->createTargetMachine();
   if (!tm) return Error{"LLVM target machine: " + llvm::toString(tm.takeError())};
   llvm::LLVMContext ctx;
-  LoweredModule lowered = lowerKernels(k, ctx, defaults.maxInstructionsPerFunction);
+  LoweredModule lowered = lowerKernels(k, ctx, defaults.maxInstructionsPerFunction, defaults.compiledPrograms);
   lowered.module->setDataLayout((*tm)->createDataLayout());
   lowered.module->setTargetTriple((*tm)->getTargetTriple().str());
   std::string verifyErrors;

@@ -14,11 +14,15 @@ namespace qdot::llvmbackend {
 
 /// What the code in an object file offers, per program.
 struct ObjectFileInfo {
-  PerProgram<std::string> entryNames;  ///< "qdot_residual", ... (ProgramFn, Jit.h)
+  /// "qdot_residual", ... (ProgramFn, Jit.h); "" for the programs that run once per simulation
+  /// (parameters, start values), which the executable runs on its embedded bytecode, as the JIT
+  /// leaves them to the interpreter (JitOptions::compiledPrograms): a component array's
+  /// parameters are one straight-line store each, and compiling them took most of qdot build.
+  PerProgram<std::string> entryNames;
   PerProgram<uint32_t> spillSlots{};   ///< doubles of scratch each needs
 };
 
-/// Compiles every program of `k` for the host (position-independent) into the object file `path`;
+/// Compiles the programs of `k` that run per step for the host (position-independent) into the object file `path`;
 /// what it offers, or why it could not be written.
 Result<ObjectFileInfo> emitObjectFile(const kernel::KernelModule& k, int optLevel, const std::string& path);
 

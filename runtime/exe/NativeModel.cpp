@@ -24,6 +24,11 @@ struct NativeModel : AdaptedModel {
 
   int run(ModelProgram program, const ModelCall& c, double* out) const {
     size_t i = programIndex(program);
+    if (!programs[i]) {  // a program that runs once (parameters, start values): the VM's
+      int status = callProgram(*vm, program, c, out);
+      if (status != 0) error = vm->lastError(vm.get());
+      return status;
+    }
     ModelCall call = c;
     call.indexTable = indexTables[i].data();
     programs[i](&call, out, spill[i].data());

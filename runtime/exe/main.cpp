@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <iostream>
 #include <span>
@@ -75,7 +76,10 @@ std::string structuralAssignment(const std::vector<std::string>& fixed, const st
 
 int main(int argc, char** argv) {
   std::span<const uint8_t> bytes(qdot_model_bytes, qdot_model_size);
-  Result<ModelPtr> created = qdot_native_programs[0]
+  // Native code for the programs that run per step, or none (built with --backend bytecode).
+  bool native = std::any_of(qdot_native_programs, qdot_native_programs + kModelProgramCount,
+                            [](qdot_program_fn f) { return f != nullptr; });
+  Result<ModelPtr> created = native
                                  ? exe::createNativeModel(bytes, qdot_native_programs, qdot_native_spill)
                                  : vm::createModelFromBytes(bytes);
   if (!created) {

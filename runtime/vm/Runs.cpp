@@ -25,11 +25,13 @@ struct Run {
   size_t values() const { return period * periods; }
 };
 
-// The run from i covering most values (the shortest period on a tie), or none if no run pays
-// for its 2 + 2p words.
+// The run from i covering most values (the shortest period on a tie; see below), or none if no
+// run pays for its 2 + 2p words.
 Run bestRunFrom(std::span<const uint32_t> v, size_t i) {
   Run best;
-  for (uint32_t p = 1; p <= kMaxPeriod; ++p) {
+  // A run of a short period that is already long ends the search: longer periods (its multiples
+  // cover about as much) would only scan it again.
+  for (uint32_t p = 1; p <= kMaxPeriod && best.values() < 16 * size_t{kMaxPeriod}; ++p) {
     Run r{p, periodsFrom(v, i, p)};
     if (r.values() > best.values()) best = r;
   }

@@ -4,7 +4,7 @@
 // in its loops' index table; written one by one they made a 150 MB executable (20 s to build).
 //
 // Words: a sequence of u32 values is the total count N, then runs until N values are produced:
-//   count c ≥ 2, period p ≤ kMaxPeriod, then p pairs (base, stride):
+//   count c ≥ 2, period p ≤ kMaxPeriod (32), then p pairs (base, stride):
 //       the c·p values v[t·p + k] = base_k + t·stride_k (mod 2³²), t < c, k < p
 //   count 0, length L ≥ 1, then L values as they are (a literal block).
 // The chain's row indices, column after column (j−1, j, j+1, n+j), are one run of period 4.
@@ -23,7 +23,9 @@
 
 namespace qdot::bc::runs {
 
-inline constexpr uint32_t kMaxPeriod = 8;
+/// Long enough for the code of one element of a straight-line program (a component array's
+/// parameter binding is 5 instructions, 16 words).
+inline constexpr uint32_t kMaxPeriod = 32;
 /// More values than this in one sequence is malformed (a guard against absurd counts: 512 MiB).
 inline constexpr uint32_t kMaxValues = 1u << 27;
 

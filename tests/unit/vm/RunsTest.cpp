@@ -71,6 +71,11 @@ TEST(Runs, RepeatedStructureCostsWordsIndependentOfItsLength) {
   std::vector<uint32_t> starts;  // CSC column starts: 0, 3, 7, 11, …
   for (uint32_t j = 0; j < 50000; ++j) starts.push_back(j == 0 ? 0 : 3 + 4 * (j - 1));
   EXPECT_LT(encoded(starts).size(), 16u);
+  std::vector<uint32_t> code;  // straight-line code of 20 words per element: registers and slots move
+  for (uint32_t e = 0; e < 20000; ++e)
+    for (uint32_t w = 0; w < 20; ++w) code.push_back(w % 3 == 0 ? 7 + w : w % 3 == 1 ? 5 * e + w : 1000 - e);
+  EXPECT_EQ(roundTrip(code), code);
+  EXPECT_LT(encoded(code).size(), 50u);
   std::mt19937 rng(3);
   std::vector<uint32_t> random(5000);
   for (auto& x : random) x = rng();
