@@ -16,6 +16,9 @@ Then the ways of writing repeated structure (FORMS: energies with arrays of para
 equations with implicit rows or algebraic unknowns, arrays of components, whose rows are rerolled)
 as templates against expanded to scalars (--no-loops, which also leaves rows unrerolled).
 
+Then standalone executables (`qdot build`): build time, size and the way to the first step per n
+(--exe-sizes), for the chain (next to the hand-written program) and the chain of Vibration parts.
+
 Then the whole process at issue 15's setting (rtol 1e-6, 1 s, KLU, columns x[1] and x[n]) for
 n = 10^3 ... 10^5 (--whole-sizes): `qdot run` in its default mode (tiering) against the hand-written
 program, wall time and peak memory, best of --repeat runs (one fresh process each).
@@ -155,6 +158,36 @@ def forms(build, n, repeat):
         print(f"| {name} | {tc:.2f} | {tw:.2f} | {tp:.0f} | {sc:.2f} | {sw:.2f} | {sp:.0f} | **{sw / tw:.1f}** |")
 
 
+# (name, model, column, largest n: the parts' chain is expanded to scalars before the DAE, 10^6 of
+# them would take minutes and tens of GB to compile)
+EXECUTABLES = [("spring chain", CHAIN, "x[1]", 10**9),
+               ("chain of `Vibration` parts", "tests/sim/models/chain_components.qd", "ms[1].s", 100000)]
+
+
+def executables(build, sizes, stop, tmp):
+    """qdot build: build time, the executable's size and its way to the first step, per n (one
+    fresh process each), next to the hand-written program's way to the first step."""
+    print(f"\n## Standalone executables (`qdot build`, --backend llvm): size and time per n (horizon {stop:g} s)\n")
+    print("| model | n | qdot build [s] | build peak [MiB] | executable [MB] | executable: start → first step [s] "
+          "| hand-written: start → first step [s] |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for name, path, column, largest in EXECUTABLES:
+        for n in (n for n in sizes if n <= largest):
+            exe = os.path.join(tmp, f"qdot-bench-exe-{n}")
+            bwall, bpeak, _ = peak_of([f"{build}/qdot", "build", path, "-p", f"n={n}", "-o", exe])
+            size = os.path.getsize(exe) / 1e6
+            wall, _, err = peak_of([exe, "--stop", str(stop), "--interval", str(stop), "--outputs", column, "-o",
+                                    "/dev/null", "--stats"])
+            first = wall - number(r"solve ([0-9.e+-]+) s", err) + number(r"first step ([0-9.e+-]+) s", err)
+            hand = "—"
+            if path == CHAIN:
+                hwall, _, herr = peak_of([f"{build}/bench/reference_sim", "chain", "--n", str(n), "--stop", str(stop),
+                                          "--interval", str(stop), "--outputs", "x[1]", "-o", "/dev/null", "--stats"])
+                hand = f"{hwall - number(r'solve ([0-9.e+-]+) s', herr) + number(r'first step ([0-9.e+-]+) s', herr):.3g}"
+            os.remove(exe)
+            print(f"| {name} | {n:,} | {bwall:.2f} | {bpeak:.0f} | {size:.2f} | {first:.3g} | {hand} |".replace(",", " "))
+
+
 def print_whole(rows, stop, repeat):
     print(f"\n## Whole process, issue 15's setting (rtol 1e-6, {stop:g} s, KLU, columns x[1], x[n]; "
           f"default mode; best of {repeat})\n")
@@ -181,6 +214,7 @@ def main():
     ap.add_argument("--whole-stop", type=float, default=1.0)
     ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("--forms-n", type=int, default=100000, help="n of the ways-of-writing table (0 skips it)")
+    ap.add_argument("--exe-sizes", default=None, help="n for the executables table (default 1000,100000,1000000; 'none' skips it)")
     a = ap.parse_args()
     sizes = [int(s) for s in a.sizes.split(",")] if a.sizes else ([1000, 10000, 100000] if a.quick else
                                                                    [1000, 10000, 100000, 1000000])
@@ -209,6 +243,10 @@ def main():
     small_models(a.build, 10)
     if a.forms_n:
         forms(a.build, a.forms_n, a.repeat)
+    if a.exe_sizes != "none":
+        exe_sizes = [int(s) for s in a.exe_sizes.split(",")] if a.exe_sizes else (
+            [1000, 100000] if a.quick else [1000, 100000, 1000000])
+        executables(a.build, exe_sizes, a.stop, os.environ.get("TMPDIR", "/tmp"))
     if a.whole_sizes != "none":
         whole_sizes = [int(s) for s in a.whole_sizes.split(",")] if a.whole_sizes else (
             [1000, 10000] if a.quick else [1000, 10000, 100000])
