@@ -7,10 +7,13 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <iostream>
 #include <span>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "exe/Embedded.h"
 #include "exe/NativeModel.h"
@@ -30,25 +33,85 @@ rt::ExperimentDefaults embeddedExperiment() {
   return e;
 }
 
+// A name as the text around its numbers and the numbers: "links[17].s0" is ("links[", "].s", "")
+// and (17, 0). Digits with a leading zero or more than 9 of them are text.
+struct NumberedName {
+  std::vector<std::string_view> text;
+  std::vector<long> numbers;
+};
+
+NumberedName splitNumbers(std::string_view name) {
+  NumberedName n;
+  size_t start = 0;  // of the current text
+  for (size_t i = 0; i < name.size();) {
+    size_t end = name.find_first_not_of("0123456789", i);
+    if (end == std::string_view::npos) end = name.size();
+    size_t digits = end - i;
+    if (digits == 0 || digits > 9 || (digits > 1 && name[i] == '0')) {
+      i = std::max(end, i + 1);
+      continue;
+    }
+    n.text.push_back(name.substr(start, i - start));
+    n.numbers.push_back(std::stol(std::string(name.substr(i, digits))));
+    start = i = end;
+  }
+  n.text.push_back(name.substr(start));
+  return n;
+}
+
+// The one number in which b follows a (b's is a's + step, the rest alike), or -1.
+int followingNumber(const NumberedName& a, const NumberedName& b, long step) {
+  if (a.text != b.text) return -1;
+  int k = -1;
+  for (size_t i = 0; i < a.numbers.size(); ++i) {
+    if (a.numbers[i] == b.numbers[i]) continue;
+    if (k >= 0 || b.numbers[i] != a.numbers[i] + step) return -1;
+    k = static_cast<int>(i);
+  }
+  return k;
+}
+
 // "Parameters" section of --help: name = default, description (defaults evaluated with nothing
-// overridden, so a default depending on another parameter shows its value).
+// overridden, so a default depending on another parameter shows its value). Runs of three or more
+// that differ in one number only, counting up, with one default and one description (the
+// members of a component array: `links[2].k`, …, `links[n].k`) are one line, `links[2..n].k = 1000`:
+// a model of 10⁵ parts would otherwise list 4·10⁵ lines.
 std::string parameterHelp(const QdotModel& model) {
   if (model.nParameters == 0) return "";
   std::vector<double> given(model.nParameters, 0.0), p(model.nParameters, 0.0);
   std::vector<uint8_t> overridden(model.nParameters, 0);
   bool ok = model.parameters(&model, given.data(), overridden.data(), p.data()) == 0;
+  auto description = [&](uint32_t i) -> std::string_view {
+    const char* d = model.parameterDescriptions ? model.parameterDescriptions[i] : "";
+    return d ? d : "";
+  };
+  auto sameDefault = [&](uint32_t i, uint32_t j) { return !ok || p[i] == p[j] || (std::isnan(p[i]) && std::isnan(p[j])); };
+  std::vector<std::pair<std::string, std::string_view>> lines;  // head, description
+  for (uint32_t i = 0; i < model.nParameters;) {
+    NumberedName first = splitNumbers(model.parameterNames[i]);
+    int k = i + 1 < model.nParameters ? followingNumber(first, splitNumbers(model.parameterNames[i + 1]), 1) : -1;
+    uint32_t j = i + 1;
+    while (k >= 0 && j < model.nParameters && followingNumber(first, splitNumbers(model.parameterNames[j]), j - i) == k &&
+           sameDefault(i, j) && description(j) == description(i))
+      ++j;
+    if (j - i < 3) j = i + 1;
+    std::string name(model.parameterNames[i]);
+    if (j - i > 1) {  // the varying number as first..last
+      name.clear();
+      for (size_t t = 0; t < first.numbers.size(); ++t) {
+        name += first.text[t];
+        name += static_cast<int>(t) == k ? fmt::format("{}..{}", first.numbers[t], first.numbers[t] + (j - i - 1))
+                                         : std::to_string(first.numbers[t]);
+      }
+      name += first.text.back();
+    }
+    lines.emplace_back(ok ? fmt::format("{} = {:g}", name, p[i]) : name, description(i));
+    i = j;
+  }
   std::size_t width = 0;
-  std::vector<std::string> heads;
-  for (uint32_t i = 0; i < model.nParameters; ++i) {
-    std::string head = ok ? fmt::format("{} = {:g}", model.parameterNames[i], p[i]) : model.parameterNames[i];
-    width = std::max(width, head.size());
-    heads.push_back(head);
-  }
+  for (const auto& line : lines) width = std::max(width, line.first.size());
   std::string text = "Parameters (change with -p NAME=VALUE; defaults shown):\n";
-  for (uint32_t i = 0; i < model.nParameters; ++i) {
-    const char* description = model.parameterDescriptions ? model.parameterDescriptions[i] : "";
-    text += fmt::format("  {:<{}}  {}\n", heads[i], width, description ? description : "");
-  }
+  for (const auto& [head, what] : lines) text += fmt::format("  {:<{}}  {}\n", head, width, what);
   return text;
 }
 

@@ -172,6 +172,11 @@ check build-parts 0 "$qdot" build "$parts" -p n=2000 -o "$work/parts"
 "$qdot" run "$parts" -p n=2000 --backend llvm --stop 0.05 -p 'ms[3].m=2' -p 'links[7].k=500' \
   --outputs 'ms[1].s,ms[3].s,ms[2000].s,links[7].b.f' >"$work/parts-run.csv"
 same parts-csv "$work/parts.csv" "$work/parts-run.csv"
+# --help lists a component array's members as ranges: 8 lines, not 6 001.
+"$work/parts" --help >"$work/parts-help.txt"
+grep -qF "ms[1..2000].m = 1" "$work/parts-help.txt" && grep -qF "links[2..2000].s0 = 0" "$work/parts-help.txt" &&
+  [ "$(sed -n '/^Parameters/,/^$/p' "$work/parts-help.txt" | grep -c ' = ')" -eq 8 ] && ok ||
+  bad "parts --help: the members of the component arrays are not listed as ranges"
 
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
