@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace qdot::dae {
 namespace {
@@ -163,6 +164,7 @@ class Builder {
       bool inertial = row.templateRow >= 0 || appears(m_.variables[v.derivative].symbol);
       kindOf[r] = inertial ? Inertial : appears(v.symbol) ? NotInertial : Algebraic;
     }
+    keepWhatTemplatesRead(kindOf);
     size_t states = std::count_if(kindOf.begin(), kindOf.end(), [](char k) { return k == Inertial || k == NotInertial; });
     firstKinematic_ = dae_.equations.size();  // appended in place (addEquations reserved room)
     kinematicPairs_.reserve(states);
@@ -196,6 +198,53 @@ class Builder {
     }
     int row = static_cast<int>(eom_.rows.size());  // the kinematic rows follow the Euler–Lagrange rows
     for (auto [coordinate, velocity] : kinematicPairs_) dae_.links.push_back({row++, coordinate, firstVelocity + velocity});
+  }
+
+  // What a template row reads counts as appearing, as a scalar row's symbols do (appears() sees only
+  // rows with a residual): a peeled element whose acceleration only a template reads (der(der(x))
+  // [%1+1] at its region's last point) is inertial, one whose velocity only a template reads keeps
+  // it among the unknowns. In a model such as the chain, the peeled rows have their own inertia and
+  // nothing changes; a pipeline-fuzzer model whose kinetic energy is cubic in the velocities
+  // (v[n] only as a factor of the last sum's term) crashed the kernel stage reading der(der(x[n])).
+  void keepWhatTemplatesRead(std::vector<char>& kindOf) const {
+    if (eom_.templateRows.empty()) return;
+    std::vector<size_t> candidates;
+    for (size_t r = 0; r < eom_.rows.size(); ++r)
+      if (kindOf[r] != Inertial && kindOf[r] != Skip && eom_.rows[r].templateRow < 0) candidates.push_back(r);
+    if (candidates.empty()) return;
+    const auto& arrays = m_.patterns->arrays;
+    std::unordered_map<Expr, std::pair<int, long>> element;  // coordinate → its array and linear index
+    for (const mech::TemplateRow& t : eom_.templateRows)
+      for (size_t k = 0; k < arrays[t.array].elements.size(); ++k) element.emplace(arrays[t.array].elements[k], std::pair{t.array, static_cast<long>(k)});
+    for (size_t r : candidates) {
+      auto it = element.find(m_.variables[eom_.rows[r].coordinate].symbol);
+      if (it == element.end()) continue;
+      auto [array, k] = it->second;
+      int velocities = arrays[array].derivative, accelerations = velocities >= 0 ? arrays[velocities].derivative : -1;
+      if (templatesRead(accelerations, arrays[array].shape, k)) kindOf[r] = Inertial;
+      else if (kindOf[r] == Algebraic && templatesRead(velocities, arrays[array].shape, k)) kindOf[r] = NotInertial;
+    }
+  }
+
+  // Whether a template row reads element k (linear) of array `a` (of `shape`) at a point of its region.
+  bool templatesRead(int a, const std::vector<int>& shape, long k) const {
+    if (a < 0) return false;
+    std::vector<long> subscript(shape.size());
+    for (size_t d = shape.size(); d-- > 0; k /= shape[d]) subscript[d] = k % shape[d] + 1;
+    for (const mech::TemplateRow& t : eom_.templateRows)
+      for (Expr s : ctx_.freeSymbols(t.residual)) {
+        const flat::RelativeElement* rel = m_.relativeElement(s);
+        if (!rel || rel->array != a) continue;
+        bool reads = true;
+        for (size_t d = 0; d < rel->dims.size() && reads; ++d) {
+          const auto& dim = rel->dims[d];
+          reads = dim.iterator < 0 ? subscript[d] == dim.offset
+                                   : subscript[d] >= t.region[dim.iterator].first + dim.offset &&
+                                         subscript[d] <= t.region[dim.iterator].second + dim.offset;
+        }
+        if (reads) return true;
+      }
+    return false;
   }
 
   // The symbols of the coordinates' rates `$der(q)`, of the states among them in row order: made

@@ -549,6 +549,24 @@ end Chain;
   EXPECT_GE(loops, 1u);
 }
 
+// Found by the fuzzer: the last element's own row has no acceleration of its own (v[n] only
+// multiplies the last term, so its momentum does not contain it), but the interior's template
+// reads der(der(x[n])): the DAE made der(x[n]) an algebraic unknown and the kernel stage stopped
+// on "a template reads an array element that is not an unknown". What a template reads now counts
+// as a row's: the unknowns are the scalar DAE's, and so are the kernels.
+TEST(LoopedKernels, AnAccelerationOnlyATemplateReadsIsAState) {
+  size_t loops = expectSameKernels(R"(model Cubic
+  parameter Integer n = 9;
+  parameter Real m = 1, c = 0.5, k = 10;
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+mechanics
+  kinetic = sum(0.5*m*der(x[i])^2*c*(der(x[i+1]) - der(x[i])) for i in 1:n-1);
+  potential = sum(0.5*k*x[i]^2 for i in 1:n);
+end Cubic;
+)");
+  EXPECT_GE(loops, 1u);
+}
+
 // A large array's start values are loops (kernel/KernelBuilder.cpp, numberRuns) that store the very
 // numbers flattening folded: 0.01*i for x[i], 0 for every velocity, derivative and nominal.
 TEST(LoopedKernels, StartValuesOfALargeArrayAreLoopsWithTheSameBits) {
