@@ -10,6 +10,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
@@ -18,6 +19,7 @@
 
 #include "bytecode/Emitter.h"
 #include "llvm/ObjectFile.h"
+#include "vm/Runs.h"
 #include "vm/Vm.h"
 
 namespace qdot::driver {
@@ -167,6 +169,20 @@ std::string checkOutputPath(const std::string& path) {
   return "";
 }
 
+namespace {
+
+// The longest list the serialised module holds (vm/Runs.h reads at most runs::kMaxValues per list).
+size_t longestList(const bc::Module& m) {
+  const ModelDescription& d = m.description;
+  size_t longest = std::max({d.variableNames.size(), d.parameterNames.size(), d.outputNames.size(),
+                             d.jacobianRowIndices.size(), d.jacobianColumnStarts.size(), m.locations.size()});
+  for (const bc::Function& f : m.functions)
+    longest = std::max({longest, f.code.size(), f.sources.size(), f.indexTable.size()});
+  return longest;
+}
+
+}  // namespace
+
 ExitCode buildExecutable(Compilation& c, const ExecutableOptions& options, std::ostream& log) {
   if (std::string why = checkOutputPath(options.outputPath); !why.empty()) {
     log << "qdot: error: cannot write the executable: " << why << "\n";
@@ -180,6 +196,12 @@ ExitCode buildExecutable(Compilation& c, const ExecutableOptions& options, std::
     return ExitCode::Internal;
   }
   if (!continueTo(c, Stage::Bytecode)) return ExitCode::ModelError;
+  if (size_t longest = longestList(*c.bytecode); longest > bc::runs::kMaxValues) {
+    log << "qdot: error: the model is too large for an executable: one of its tables (the Jacobian's "
+        << c.bytecode->description.jacobianNonzeros() << " nonzeros, or a program's code) has " << longest
+        << " entries, more than the " << bc::runs::kMaxValues << " the embedded form holds; run it with qdot run\n";
+    return ExitCode::ModelError;
+  }
   std::vector<uint8_t> bytes = bc::serialize(*c.bytecode);
   {  // the bytes must load exactly as the executable will load them
     Result<ModelPtr> model = vm::createModelFromBytes(bytes);
