@@ -4,7 +4,7 @@ when the policy expects it to pay) ever slower than the better of the two fixed 
 
 Runs every example model (examples/**/*.qd, its own experiment settings) and the benchmark models
 (the spring chain at n = 1 000, 10 000, 100 000 and the 8-link pendulum, with the stop times of
-sim_bench.py and jit_bench.py) as whole `qdot run` commands in three modes, interleaved:
+sim_bench.py and jit_bench.py; the chain of 10 000 Vibration parts to 1 s) as whole `qdot run` commands in three modes, interleaved:
   default   qdot run                          (the tiering policy)
   bytecode  qdot run --backend bytecode       (the VM only)
   jit-wait  qdot run --backend llvm --jit-wait  (the JIT compiles before the first step)
@@ -27,6 +27,7 @@ import time
 
 CHAIN = "examples/vibration/spring_chain.qd"
 PENDULUM = "examples/pendulum/nlink.qd"
+PARTS = "tests/sim/models/chain_components.qd"
 MODES = {"default": [], "bytecode": ["--backend", "bytecode"], "jit-wait": ["--backend", "llvm", "--jit-wait"]}
 TARGET = 1.10
 LONG = 20.0  # seconds: runs this long are measured once
@@ -40,6 +41,9 @@ def benchmark_cases(quick):
     for n, stop in sizes:
         cases.append((f"spring chain n = {n}", CHAIN,
                       ["-p", f"n={n}", "--stop", repr(stop), "--outputs", f"x[1],x[{n}]"]))
+    # arrays of components: expanded before the DAE, their rows rerolled into loops (docs/loops.md)
+    cases.append(("chain of Vibration parts n = 10000", PARTS,
+                  ["-p", "n=10000", "--stop", "1", "--outputs", "ms[1].s,ms[10000].s"]))
     return cases
 
 
