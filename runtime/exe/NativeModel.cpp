@@ -16,10 +16,9 @@ namespace qdot::exe {
 namespace {
 
 struct NativeModel : AdaptedModel {
-  ModelDescription description;  // names and pattern the table points into
-  ModelPtr vm;                   // the same module on the VM, for the diagnosis of failures
+  ModelPtr vm;                   // the same module on the VM: the programs that run once, the diagnosis of failures
+  const bc::Module* module = nullptr;  // the VM's: names and pattern the table points into, index tables
   PerProgram<qdot_program_fn> programs{};
-  PerProgram<std::vector<uint32_t>> indexTables;  // the native code reads them through the call
   mutable PerProgram<std::vector<double>> spill;
 
   int run(ModelProgram program, const ModelCall& c, double* out) const {
@@ -30,9 +29,9 @@ struct NativeModel : AdaptedModel {
       return status;
     }
     ModelCall call = c;
-    call.indexTable = indexTables[i].data();
+    call.indexTable = module->functions[i].indexTable.data();  // the native code reads it through the call
     programs[i](&call, out, spill[i].data());
-    size_t count = description.outputCount(program);
+    size_t count = module->description.outputCount(program);
     if (std::all_of(out, out + count, [](double x) { return std::isfinite(x); })) return 0;
     std::vector<double> scratch(count);  // the VM fails the same way and says where
     error = callProgram(*vm, program, c, scratch.data()) != 0 ? vm->lastError(vm.get()) : "a value is not finite";
@@ -44,19 +43,16 @@ struct NativeModel : AdaptedModel {
 
 Result<ModelPtr> createNativeModel(std::span<const uint8_t> bytes, const qdot_program_fn programs[kModelProgramCount],
                                    const uint32_t spill[kModelProgramCount]) {
-  Result<bc::Module> module = bc::deserialize(bytes);
-  if (!module) return Error{module.error()};
   auto m = std::make_unique<NativeModel>();
-  m->description = module->description;
-  for (size_t i = 0; i < kModelProgramCount; ++i) m->indexTables[i] = module->functions[i].indexTable;
-  Result<ModelPtr> vm = vm::createModel(std::move(module).value());
+  Result<ModelPtr> vm = vm::createModelFromBytes(bytes);
   if (!vm) return Error{vm.error()};
   m->vm = std::move(vm).value();
+  m->module = &vm::moduleOf(*m->vm);
   for (size_t i = 0; i < kModelProgramCount; ++i) {
     m->programs[i] = programs[i];
     m->spill[i].assign(spill[i], 0.0);
   }
-  ModelAdapter<NativeModel>::install(*m, m->description);
+  ModelAdapter<NativeModel>::install(*m, m->module->description);
   return ModelPtr(m.release());
 }
 

@@ -28,10 +28,8 @@ struct VmModel : AdaptedModel {
   }
 };
 
-}  // namespace
-
-Result<ModelPtr> createModel(bc::Module module) {
-  if (Status valid = bc::validate(module); !valid) return Error{valid.error()};
+// A model of a module that validates.
+ModelPtr modelOfValid(bc::Module module) {
   auto m = std::make_unique<VmModel>();
   m->module = std::move(module);
   for (size_t f = 0; f < kModelProgramCount; ++f) m->registers[f] = makeRegisters(m->module.functions[f]);
@@ -39,10 +37,19 @@ Result<ModelPtr> createModel(bc::Module module) {
   return ModelPtr(m.release());
 }
 
+}  // namespace
+
+Result<ModelPtr> createModel(bc::Module module) {
+  if (Status valid = bc::validate(module); !valid) return Error{valid.error()};
+  return modelOfValid(std::move(module));
+}
+
+const bc::Module& moduleOf(const QdotModel& model) { return static_cast<const VmModel&>(model).module; }
+
 Result<ModelPtr> createModelFromBytes(std::span<const uint8_t> bytes) {
-  Result<bc::Module> module = bc::deserialize(bytes);
+  Result<bc::Module> module = bc::deserialize(bytes);  // validates (once: a large module's code is long)
   if (!module) return Error{module.error()};
-  return createModel(std::move(module).value());
+  return modelOfValid(std::move(module).value());
 }
 
 }  // namespace qdot::vm

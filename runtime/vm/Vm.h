@@ -15,6 +15,10 @@ namespace qdot::vm {
 Result<ModelPtr> createModel(bc::Module module);
 /// The same from serialised bytes (bc::serialize).
 Result<ModelPtr> createModelFromBytes(std::span<const uint8_t> bytes);
+/// The module a model made by createModel runs (valid as long as the model): what a model that
+/// runs the same module otherwise (an executable's native code) reads instead of a copy of its
+/// description and index tables, which a large model's are. `model` must come from createModel.
+const bc::Module& moduleOf(const QdotModel& model);
 
 /// Text of every function: constants, then one instruction per line with its word offset and,
 /// whenever it changes, the source it serves. Deterministic.
