@@ -18,6 +18,7 @@
 #include "ida/ModelCheck.h"
 #include "output/AngleUnwrap.h"
 #include "sim/Names.h"
+#include "sim/PeakMemory.h"
 
 namespace qdot::rt {
 namespace {
@@ -297,6 +298,7 @@ SimulationResult simulateWith(const QdotModel& model, const SimulationSettings& 
   if constexpr (requires(Session& s) { s.firstStepDone(); })
     if (solving && session->firstStepDone())
       result.firstStepSeconds = std::chrono::duration<double>(*session->firstStepDone() - clock).count();
+  result.peakMemoryBytes = peakResidentBytes();
   try {
     sink.finish();
   } catch (const std::exception& e) {

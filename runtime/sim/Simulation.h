@@ -90,6 +90,9 @@ struct SimulationResult {
   /// Wall time from the start of the solve to IDA's first completed step (its first matrix
   /// factorization included); the whole solve if that was not seen (ARKODE, a run of one step).
   double firstStepSeconds = 0;
+  /// The process's peak resident memory when the run ended (compiling included, for `qdot run`),
+  /// in bytes; 0 where the system does not say.
+  size_t peakMemoryBytes = 0;
 };
 
 /// Runs the model over the grid, writing into sink (begin, rows, finish). Never throws for
