@@ -76,7 +76,9 @@ struct QdotModel {
    * initialisation (0); written into fixed[nVariables]. */
   int (*fixedStarts)(const QdotModel* self, int32_t* fixed);
   int (*residual)(const QdotModel* self, double t, const double* y, const double* yp, const double* p, double* F);
-  /* Values of J = dF/dy + cj*dF/dy' in the CSC pattern above. */
+  /* Values of J = dF/dy + cj*dF/dy' in the CSC pattern above: every one of the jacobianNonzeros
+   * values on every call (the runtime does not clear them in between; a value never written keeps
+   * the 0 it starts with). */
   int (*jacobian)(const QdotModel* self, double t, const double* y, const double* yp, const double* p, double cj,
                   double* values);
   int (*outputs)(const QdotModel* self, double t, const double* y, const double* yp, const double* p, double* out);
