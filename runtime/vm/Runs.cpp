@@ -2,6 +2,7 @@
 #include "vm/Runs.h"
 
 #include <algorithm>
+#include <charconv>
 #include <string_view>
 #include <unordered_map>
 
@@ -147,13 +148,15 @@ bool joinStrings(const StringTemplates& t, std::vector<std::string>& strings) {
     if (id >= t.templates.size() || t.templates[id].empty()) return false;
     const StringTemplates::Template& parts = t.templates[id];
     if (t.numbers.size() - next < parts.size() - 1) return false;
-    std::string s = parts[0];
+    std::string& s = strings.emplace_back();
+    s.reserve(parts[0].size() + 10 * (parts.size() - 1) + parts.back().size());
+    s.append(parts[0]);
     for (size_t k = 1; k < parts.size(); ++k) {
       uint32_t number = t.numbers[next++];
       if (number > kLargestNumber) return false;  // would not be read back as one number
-      s.append(std::to_string(number)).append(parts[k]);
+      char digits[10];
+      s.append(digits, std::to_chars(digits, digits + sizeof digits, number).ptr).append(parts[k]);
     }
-    strings.push_back(std::move(s));
   }
   return next == t.numbers.size();
 }
