@@ -431,9 +431,10 @@ Value Flattener::variablesFor(const Declaration& d, const std::vector<int>& shap
   while (top->parent && top->parent->parent) top = top->parent;
   SourceRange where = top->decl ? top->decl->nameRange : d.nameRange;
   int attributes = 0;  // one record for the declaration's description, shared by its elements
-  if (!d.description.empty()) {
-    attributes = static_cast<int>(out_.attributes.size());
-    out_.attributes.push_back({.description = d.description});
+  if (!d.description.empty()) {  // and by every instance of its class
+    auto [record, added] = descriptionRecords_.try_emplace(d.description.data(), static_cast<int>(out_.attributes.size()));
+    if (added) out_.attributes.push_back({.description = d.description});
+    attributes = record->second;
   }
   NameBuffer names;
   auto make = [&] {

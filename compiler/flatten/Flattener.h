@@ -233,6 +233,10 @@ class Flattener {
   std::map<std::pair<const ast::Modification*, const Instance*>, ModEntry> extendsEntries_;
   std::unordered_set<const ast::Modification*> badModifiers_;  ///< reported once, not per element
   std::vector<Instance*> varOwner_;       ///< by variable: the instance that declared it
+  /// The attribute record of a declaration's description alone (FlatModel::attributes), by the
+  /// description's text in the AST: shared by every instance of the declaration's class (a
+  /// component array's members), as by an array's elements; setAttribute copies before it changes one.
+  std::unordered_map<const char*, int> descriptionRecords_;
   std::vector<char> connectorPotential_;  ///< by variable: a potential of a connector
   std::vector<Connection> connections_;
   std::vector<size_t> aliasCandidates_;   ///< equations that may be aliases (`x = ±y`, `x = known`)
