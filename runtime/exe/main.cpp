@@ -19,6 +19,7 @@
 #include "exe/NativeModel.h"
 #include "sim/Names.h"
 #include "sim/Run.h"
+#include "vm/Runs.h"
 #include "vm/Vm.h"
 
 namespace {
@@ -33,43 +34,31 @@ rt::ExperimentDefaults embeddedExperiment() {
   return e;
 }
 
-// A name as the text around its numbers and the numbers: "links[17].s0" is ("links[", "].s", "")
-// and (17, 0). Digits with a leading zero or more than 9 of them are text.
-struct NumberedName {
-  std::vector<std::string_view> text;
-  std::vector<long> numbers;
-};
+// Parameter names as templates and numbers (the serialised form's split, vm/Runs.h): name i is
+// template templateOf[i] with the numbers from first[i] on.
+struct SplitNames {
+  bc::runs::StringTemplates t;
+  std::vector<size_t> first;
 
-NumberedName splitNumbers(std::string_view name) {
-  NumberedName n;
-  size_t start = 0;  // of the current text
-  for (size_t i = 0; i < name.size();) {
-    size_t end = name.find_first_not_of("0123456789", i);
-    if (end == std::string_view::npos) end = name.size();
-    size_t digits = end - i;
-    if (digits == 0 || digits > 9 || (digits > 1 && name[i] == '0')) {
-      i = std::max(end, i + 1);
-      continue;
+  explicit SplitNames(const QdotModel& model)
+      : t(bc::runs::splitStrings(std::vector<std::string>(model.parameterNames, model.parameterNames + model.nParameters))) {
+    for (size_t i = 0, at = 0; i < t.templateOf.size(); at += t.templates[t.templateOf[i++]].size() - 1) first.push_back(at);
+  }
+  const bc::runs::StringTemplates::Template& parts(size_t i) const { return t.templates[t.templateOf[i]]; }
+  uint32_t number(size_t i, size_t k) const { return t.numbers[first[i] + k]; }
+
+  // The one number in which name j follows name i (j's is i's + step, the rest alike), or -1.
+  int followingNumber(size_t i, size_t j, uint32_t step) const {
+    if (t.templateOf[i] != t.templateOf[j]) return -1;
+    int k = -1;
+    for (size_t n = 0; n + 1 < parts(i).size(); ++n) {
+      if (number(i, n) == number(j, n)) continue;
+      if (k >= 0 || number(j, n) != number(i, n) + step) return -1;
+      k = static_cast<int>(n);
     }
-    n.text.push_back(name.substr(start, i - start));
-    n.numbers.push_back(std::stol(std::string(name.substr(i, digits))));
-    start = i = end;
+    return k;
   }
-  n.text.push_back(name.substr(start));
-  return n;
-}
-
-// The one number in which b follows a (b's is a's + step, the rest alike), or -1.
-int followingNumber(const NumberedName& a, const NumberedName& b, long step) {
-  if (a.text != b.text) return -1;
-  int k = -1;
-  for (size_t i = 0; i < a.numbers.size(); ++i) {
-    if (a.numbers[i] == b.numbers[i]) continue;
-    if (k >= 0 || b.numbers[i] != a.numbers[i] + step) return -1;
-    k = static_cast<int>(i);
-  }
-  return k;
-}
+};
 
 // "Parameters" section of --help: name = default, description (defaults evaluated with nothing
 // overridden, so a default depending on another parameter shows its value). Runs of three or more
@@ -87,23 +76,23 @@ std::string parameterHelp(const QdotModel& model) {
   };
   auto sameDefault = [&](uint32_t i, uint32_t j) { return !ok || p[i] == p[j] || (std::isnan(p[i]) && std::isnan(p[j])); };
   std::vector<std::pair<std::string, std::string_view>> lines;  // head, description
+  SplitNames names(model);
   for (uint32_t i = 0; i < model.nParameters;) {
-    NumberedName first = splitNumbers(model.parameterNames[i]);
-    int k = i + 1 < model.nParameters ? followingNumber(first, splitNumbers(model.parameterNames[i + 1]), 1) : -1;
+    int k = i + 1 < model.nParameters ? names.followingNumber(i, i + 1, 1) : -1;
     uint32_t j = i + 1;
-    while (k >= 0 && j < model.nParameters && followingNumber(first, splitNumbers(model.parameterNames[j]), j - i) == k &&
-           sameDefault(i, j) && description(j) == description(i))
+    while (k >= 0 && j < model.nParameters && names.followingNumber(i, j, j - i) == k && sameDefault(i, j) &&
+           description(j) == description(i))
       ++j;
     if (j - i < 3) j = i + 1;
     std::string name(model.parameterNames[i]);
     if (j - i > 1) {  // the varying number as first..last
-      name.clear();
-      for (size_t t = 0; t < first.numbers.size(); ++t) {
-        name += first.text[t];
-        name += static_cast<int>(t) == k ? fmt::format("{}..{}", first.numbers[t], first.numbers[t] + (j - i - 1))
-                                         : std::to_string(first.numbers[t]);
+      const auto& parts = names.parts(i);
+      name = parts[0];
+      for (size_t n = 0; n + 1 < parts.size(); ++n) {
+        uint32_t v = names.number(i, n);
+        name += static_cast<int>(n) == k ? fmt::format("{}..{}", v, v + (j - i - 1)) : std::to_string(v);
+        name += parts[n + 1];
       }
-      name += first.text.back();
     }
     lines.emplace_back(ok ? fmt::format("{} = {:g}", name, p[i]) : name, description(i));
     i = j;
