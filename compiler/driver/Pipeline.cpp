@@ -313,6 +313,25 @@ std::optional<flat::FlatModel> flattenKeepingEquations(Compilation& c, flat::Fla
   return std::nullopt;
 }
 
+// The first array of components of a model ("ms[1]"), or "".
+std::string firstComponentArray(const flat::FlatModel& m) {
+  for (const std::string& path : m.components)
+    if (path.find('[') != std::string::npos) return path;
+  return "";
+}
+
+// A run of a model with arrays of components that asks for some results only (`qdot run --outputs`):
+// its components' energies summed over their connections (flat::sumConnectedEnergies), a
+// Lagrangian over the coordinates whose repeated structure can stay templates. Returns why not
+// ("" if it was rewritten, or has no array of components).
+std::string sumComponentArrays(flat::FlatModel& m, Compilation& c) {
+  if (!c.options.keepLoops || firstComponentArray(m).empty()) return "";
+  if (c.options.results.empty()) return "every result is asked for, the connectors' flows too";
+  std::string why = flat::sumConnectedEnergies(m, c.ctx, c.options.results);
+  if (why.empty()) flat::rerollTerms(m, c.ctx, c.options.rerollMinimumRun);
+  return why;
+}
+
 bool flatten(Compilation& c) {
   c.flat = timed(c.times.flatten, [&] {
     flat::FlattenLimits limits = c.options.limits;
@@ -323,6 +342,7 @@ bool flatten(Compilation& c) {
         return model;
       }
     auto model = flat::flatten(*c.checked, c.ctx, c.diags, limits, c.options.structural);
+    std::string componentsWhy = model && !c.diags.hasErrors() ? sumComponentArrays(*model, c) : "";
     std::optional<std::vector<int>> defined;
     size_t failing = 0;
     if (model) defined = model->equations.empty() ? std::vector<int>{} : explicitDefinitions(*model, c.ctx, failing);
@@ -333,12 +353,9 @@ bool flatten(Compilation& c) {
                                                     : "its repeated structure is only in outputs or equations";
     bool templates = model && defined && hasTemplates(*model) && why.empty();
     if (repeated) c.loops = templates ? "" : why;
-    if (model && !repeated)
-      for (const std::string& path : model->components)
-        if (path.find('[') != std::string::npos) {
-          c.loops = "it has arrays of components (" + path + ", …), which are expanded";
-          break;
-        }
+    if (model && !repeated && !firstComponentArray(*model).empty())
+      c.loops = "it has arrays of components (" + firstComponentArray(*model) + ", …), which are expanded" +
+                (componentsWhy.empty() ? "" : ": " + componentsWhy);
     if (templates && !defined->empty()) {
       defineAsOutputs(*model, *defined, c.ctx);
       c.eliminated.eliminated = defined->size();  // solved out as the scalar DAE would have them

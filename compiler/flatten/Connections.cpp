@@ -45,15 +45,6 @@ struct UnionFind {
 
 bool isUnknownOrCoordinate(const Variable& v) { return v.role == VarRole::Unknown || v.role == VarRole::Coordinate; }
 
-/// `s` or `-s` for a symbol s: (s, ±1).
-std::optional<std::pair<Expr, int>> signedSymbol(Expr e) {
-  if (e->isSymbol()) return std::pair{e, 1};
-  if (e->kind == sym::Kind::Mul && (e->value == 1 || e->value == -1) && e->args.size() == 1 && e->args[0]->isSymbol() &&
-      e->exps[0]->isOne())
-    return std::pair{e->args[0], e->value > 0 ? 1 : -1};
-  return std::nullopt;
-}
-
 /// A residual c*x + d*y with |c| = |d| (`x = y`, `x = -y`, `x + y = 0`): (x, y, sign) with x = sign*y.
 std::optional<std::tuple<Expr, Expr, int>> symbolPair(Expr r) {
   if (r->kind != sym::Kind::Add || r->value != 0 || r->args.size() != 2 || !r->args[0]->isSymbol() ||
@@ -63,6 +54,14 @@ std::optional<std::tuple<Expr, Expr, int>> symbolPair(Expr r) {
 }
 
 }  // namespace
+
+std::optional<std::pair<Expr, int>> signedSymbol(Expr e) {
+  if (e->isSymbol()) return std::pair{e, 1};
+  if (e->kind == sym::Kind::Mul && (e->value == 1 || e->value == -1) && e->args.size() == 1 && e->args[0]->isSymbol() &&
+      e->exps[0]->isOne())
+    return std::pair{e->args[0], e->value > 0 ? 1 : -1};
+  return std::nullopt;
+}
 
 /// Known values (start values, what a class of variables is given) as numbers for the alias pass,
 /// which only compares them and negates them: each expression up to its sign gets a key k >= 1,

@@ -61,6 +61,25 @@ void expandEquationSums(FlatModel& model, sym::Context& ctx);
 /// clears the templates.
 void expandIndexedSums(FlatModel& model, sym::Context& ctx);
 
+/// `s` or `-s` for a symbol s: (s, ±1); nullopt for anything else (an alias's value).
+std::optional<std::pair<sym::Expr, int>> signedSymbol(sym::Expr e);
+
+/// Components' energies summed over their connections (SummedEnergies.cpp): where every
+/// connector's flow is read only by the force its connection made on a coordinate, the aliases are
+/// substituted into the energies and forces, and the flows, the aliased variables and the
+/// connections' forces leave the model, which then is one Lagrangian over the coordinates (the
+/// rows of each connection node summed; its flows cancel in the sum). `results`: the results asked
+/// for (a flow among them keeps the model as it is; an aliased variable becomes an output). Returns
+/// "" if the model was rewritten, else why not (and leaves it untouched).
+std::string sumConnectedEnergies(FlatModel& model, sym::Context& ctx, std::span<const std::string> results);
+
+/// Energy terms that repeat along arrays of components as IndexedSums (RerollTerms.cpp): variables
+/// named alike but for one subscript numbered 1..N (`ms[i].s`) become an array (`ms.s`), and a run
+/// of at least `minimumRun` consecutive terms of one statement, each the one before with every
+/// such subscript one higher, one sum over its box. Parameters the sums read are renumbered to
+/// consecutive variables per array. Returns the number of sums made.
+size_t rerollTerms(FlatModel& model, sym::Context& ctx, size_t minimumRun);
+
 /// Whether a loop can read relative symbol `rel` of a template over `rank` iterators, whose rows are
 /// laid out in an array of `shape`, as the parameter p[first + the row's linear index + offset]:
 /// every element of its array a parameter, the elements consecutive variables (the DAE numbers

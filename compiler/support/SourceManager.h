@@ -16,6 +16,7 @@ struct SourceRange {
   uint32_t end = 0;
 
   bool valid() const { return file != UINT32_MAX; }
+  bool operator==(const SourceRange&) const = default;
   /// The smallest range covering both (same file assumed).
   static SourceRange cover(SourceRange a, SourceRange b) {
     if (!a.valid()) return b;

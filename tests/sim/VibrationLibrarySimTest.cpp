@@ -599,6 +599,62 @@ TEST(VibrationLibrary, ARerolledChainOfComponentArraysEqualsTheFlatChain) {
   }
 }
 
+// The chain of parts run with some results asked for, none of them a connector's flow: the parts'
+// energies are summed over their connections (flat::sumConnectedEnergies: the flows leave the
+// model) and the terms that repeat along the arrays become sums again (flat::rerollTerms), so the
+// run is compiled as loops from its energies, as the flat chain is (--stats says so). Reference:
+// the flat chain, mass by mass, with the bounds of the test above; a potential asked for (ms[3].a.s,
+// made ms[3].s by the part's equation) is still a column.
+TEST(VibrationLibrary, AChainOfComponentArraysAskedForSomeResultsIsCompiledAsLoops) {
+  std::vector<std::string> args = {"--rtol", num(kRtol), "-p", "n=40", "--stop", "0.5"};
+  auto flat = runQdot("examples/vibration/spring_chain.qd", args);
+  std::string outputs = "ms[3].a.s,ms[3].s";
+  for (int i : {1, 2, 20, 39, 40}) outputs += ",ms[" + std::to_string(i) + "].s,der(ms[" + std::to_string(i) + "].s)";
+  args.insert(args.end(), {"--outputs", outputs, "--stats"});
+  auto parts = runQdot("tests/sim/models/chain_components.qd", args);
+  ASSERT_EQ(flat.exitCode, 0) << flat.log;
+  ASSERT_EQ(parts.exitCode, 0) << parts.log;
+  EXPECT_NE(parts.log.find("loops: the model's repeated structure is compiled as loops"), std::string::npos) << parts.log;
+  for (int i : {1, 2, 20, 39, 40}) {
+    const std::string index = std::to_string(i);
+    expectSameTrajectory(flat, parts, "x[" + index + "]", "ms[" + index + "].s", 0.4, 0.4 * 64, 2 * M_PI / 64);
+  }
+  EXPECT_EQ(parts.col("ms[3].a.s"), parts.col("ms[3].s"));
+}
+
+// A chain of graded parts (masses, stiffnesses and dampings differ from element to element; masses
+// declared first, connections written mass-first): the run that asks for its masses only (energies
+// summed, templates reading each part's parameters in a loop) against the run that also asks for a
+// link force, which keeps the parts' rows and flows (expanded, then rerolled) — --stats says why.
+// Both are within 2 oscillationBound of the exact solution: V0 ≤ n ½ k_max (0.01 m)² = 2.4 J for
+// n = 30, |x_i| ≤ √(n 2V0/k_min) = 0.38 m, |ẋ_i| ≤ √(2V0/m_min) = 3.1 m/s, the fastest mode below
+// 2√(k_max/m_min) = 113 rad/s. The link force obeys its law with the masses' results.
+TEST(VibrationLibrary, AGradedChainOfPartsGivesOneMotionWithAndWithoutItsFlows) {
+  std::vector<std::string> args = {"--rtol", num(kRtol), "-p", "n=30", "--stop", "0.5", "--stats", "--outputs"};
+  std::string outputs;
+  for (int i : {1, 2, 17, 30}) outputs += (outputs.empty() ? "" : ",") + ("ms[" + std::to_string(i) + "].s,der(ms[" + std::to_string(i) + "].s)");
+  auto some = args, withFlow = args;
+  some.push_back(outputs);
+  withFlow.push_back(outputs + ",links[2].b.f");
+  auto summed = runQdot("tests/sim/models/graded_chain_components.qd", some);
+  auto expanded = runQdot("tests/sim/models/graded_chain_components.qd", withFlow);
+  ASSERT_EQ(summed.exitCode, 0) << summed.log;
+  ASSERT_EQ(expanded.exitCode, 0) << expanded.log;
+  EXPECT_NE(summed.log.find("loops: the model's repeated structure is compiled as loops"), std::string::npos) << summed.log;
+  EXPECT_NE(expanded.log.find("the flow 'links[2].b.f' is among the results asked for"), std::string::npos) << expanded.log;
+  for (int i : {1, 2, 17, 30}) {
+    const std::string name = "ms[" + std::to_string(i) + "].s";
+    expectSameTrajectory(expanded, summed, name, name, 0.38, 3.1, 2 * M_PI / 113);
+  }
+  const double k = 1000 + 20 * 2, c = 0.5 + 0.01 * 2;
+  const auto &s1 = expanded.col("ms[1].s"), &s2 = expanded.col("ms[2].s"), &f = expanded.col("links[2].b.f");
+  const auto &v1 = expanded.col("der(ms[1].s)"), &v2 = expanded.col("der(ms[2].s)");
+  for (std::size_t row = 0; row < expanded.rows; ++row) {
+    double law = k * (s2[row] - s1[row]) + c * (v2[row] - v1[row]);
+    ASSERT_NEAR(f[row], law, 1e-12 * (1 + std::fabs(law))) << "at t = " << expanded.time()[row];
+  }
+}
+
 // The same chain's link forces: `qdot run` solves them out of the system (dae/ExplicitAlgebraics.h)
 // and computes them with the results, so the run integrates the 2n states alone (every unknown
 // differential: y'(t0) by one division, no IDACalcIC). Reference: each link's law, b.f = k (s_i −
