@@ -29,6 +29,7 @@ class Summation {
   std::string run(std::span<const std::string> results) {
     if (std::string why = shapeOfModel(); !why.empty()) return why;
     if (std::string why = findFlows(); !why.empty()) return why;
+    if (std::string why = solveBalances(); !why.empty()) return why;
     resolveAliases();
     if (std::string why = flowsReadOnlyByConnections(); !why.empty()) return why;
     std::vector<std::pair<int, Term>> forces;
@@ -44,18 +45,20 @@ class Summation {
   sym::Context& ctx_;
   std::vector<char> isFlow_;     // by variable
   std::vector<Expr> aliasOf_;    // by symbol id: the resolved alias (null: none)
+  std::vector<std::pair<Expr, Expr>> balances_;  // a flow a connection's balance gives: (flow, value)
   uint64_t aliasMask_ = 0;
 
   bool aliased(int v) const { return m_.variables[v].alias != nullptr; }
   Expr substituted(Expr e) const { return e && aliasMask_ ? ctx_.substitute(e, aliasOf_, aliasMask_) : e; }
 
-  // Only energies, forces and outputs: no constraint (index reduction), no equation of its own (the
-  // connections' flow balances and a component's equations over flows need the flows), no
+  // Only energies, forces and outputs: no constraint (index reduction), no equation but the
+  // connections' flow balances (a component's equations over its flows need the flows), no
   // template, and connections that do no work (spec §7: every flow acts on a coordinate or where
   // the potential is fixed).
   std::string shapeOfModel() const {
     if (!m_.constraints.empty()) return "it has a constraint";
-    if (!m_.equations.empty()) return "it has equations besides its connections' aliases";
+    for (const Equation& e : m_.equations)
+      if (e.origin.kind != OriginKind::Connection) return "it has equations besides its connections";
     if (!m_.initialEquations.empty()) return "it has initial equations";
     if (!m_.indexedSums.empty() || !m_.indexedForces.empty() || !m_.equationTemplates.empty() || !m_.equationSums.empty())
       return "it has templates of its own";
@@ -80,6 +83,11 @@ class Summation {
     auto add = [&](int v) {
       if (!isFlow_[v]) isFlow_[v] = 1, work.push_back(v);
     };
+    for (const Equation& e : m_.equations)  // a connection's balance: every symbol a flow
+      for (Expr s : ctx_.freeSymbols(e.residual)) {
+        if (unknown(s) < 0) return "a connection's balance reads '" + ctx_.symbolName(s) + "', which is no flow";
+        add(unknown(s));
+      }
     for (const auto& [q, t] : m_.forces)
       if (t.connectionFlow) {
         int v = t.value->isSymbol() ? unknown(t.value) : -1;
@@ -100,12 +108,40 @@ class Summation {
     return "";
   }
 
+  // Each balance of three or more flows (c1 f1 + c2 f2 + … = 0) gives its last flow that is not an
+  // alias as the others' combination, as the two-flow connections give theirs (f2 = -f1): the
+  // forces on each node then cancel through these values alone.
+  std::string solveBalances() {
+    std::vector<char> given(m_.variables.size(), 0);
+    for (const Equation& e : m_.equations) {
+      Expr r = e.residual;
+      if (r->kind != sym::Kind::Add || r->value != 0) return "a connection's balance is not a sum of flows";
+      int pick = -1;
+      for (int k = static_cast<int>(r->args.size()) - 1; k >= 0 && pick < 0; --k) {
+        int v = r->args[k]->isSymbol() ? m_.variableOf(r->args[k]) : -1;
+        if (v >= 0 && !aliased(v) && !given[v]) pick = k;
+      }
+      if (pick < 0) return "a connection's balance has no flow of its own";
+      std::vector<Expr> others;
+      std::vector<double> coefs;
+      for (size_t k = 0; k < r->args.size(); ++k)
+        if (static_cast<int>(k) != pick) others.push_back(r->args[k]), coefs.push_back(-r->coefs[k] / r->coefs[pick]);
+      given[m_.variableOf(r->args[pick])] = 1;
+      balances_.push_back({r->args[pick], ctx_.linearCombination(others, coefs)});
+    }
+    return "";
+  }
+
   // Every alias to the end of its chain (an alias of an alias), by symbol id.
   void resolveAliases() {
     aliasOf_.assign(ctx_.symbolCount(), nullptr);
     std::vector<Expr> from;
+    auto note = [&](Expr s, Expr value) {
+      aliasOf_[s->symbolId] = value, aliasMask_ |= uint64_t{1} << (s->symbolId % 64), from.push_back(s);
+    };
     for (const Variable& v : m_.variables)
-      if (v.alias) aliasOf_[v.symbol->symbolId] = v.alias, aliasMask_ |= uint64_t{1} << (v.symbol->symbolId % 64), from.push_back(v.symbol);
+      if (v.alias) note(v.symbol, v.alias);
+    for (auto [flow, value] : balances_) note(flow, value);
     for (Expr s : from) {
       Expr& to = aliasOf_[s->symbolId];
       for (int depth = 0; depth < 64; ++depth) {  // chains are short; a cycle cannot come from the alias pass
@@ -213,6 +249,7 @@ class Summation {
       if (!aliased(static_cast<int>(v)) && !isFlow_[v]) newIndex[v] = kept++;
     for (auto& [q, t] : forces) q = newIndex[q];
     m_.forces = std::move(forces);
+    m_.equations.clear();  // the balances, which the summed rows fulfil
     compact(newIndex);
   }
 

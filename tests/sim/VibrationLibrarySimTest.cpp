@@ -622,6 +622,25 @@ TEST(VibrationLibrary, AChainOfComponentArraysAskedForSomeResultsIsCompiledAsLoo
   EXPECT_EQ(parts.col("ms[3].a.s"), parts.col("ms[3].s"));
 }
 
+// The chain with each spring and damper a part of its own, in parallel (three flanges at every
+// node: each connection a flow balance, whose last flow the sum takes as the others' combination):
+// compiled as loops too. Reference: the flat chain, as above.
+TEST(VibrationLibrary, AChainOfParallelPartsIsCompiledAsLoops) {
+  std::vector<std::string> args = {"--rtol", num(kRtol), "-p", "n=40", "--stop", "0.5"};
+  auto flat = runQdot("examples/vibration/spring_chain.qd", args);
+  std::string outputs;
+  for (int i : {1, 21, 40}) outputs += (outputs.empty() ? "" : ",") + ("ms[" + std::to_string(i) + "].s,der(ms[" + std::to_string(i) + "].s)");
+  args.insert(args.end(), {"--outputs", outputs, "--stats"});
+  auto parts = runQdot("tests/sim/models/parallel_chain_components.qd", args);
+  ASSERT_EQ(flat.exitCode, 0) << flat.log;
+  ASSERT_EQ(parts.exitCode, 0) << parts.log;
+  EXPECT_NE(parts.log.find("loops: the model's repeated structure is compiled as loops"), std::string::npos) << parts.log;
+  for (int i : {1, 21, 40}) {
+    const std::string index = std::to_string(i);
+    expectSameTrajectory(flat, parts, "x[" + index + "]", "ms[" + index + "].s", 0.4, 0.4 * 64, 2 * M_PI / 64);
+  }
+}
+
 // A chain of graded parts (masses, stiffnesses and dampings differ from element to element; masses
 // declared first, connections written mass-first): the run that asks for its masses only (energies
 // summed, templates reading each part's parameters in a loop) against the run that also asks for a
