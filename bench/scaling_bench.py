@@ -131,8 +131,10 @@ FORMS = [("spring chain, energies", CHAIN, "x[1]"),
          ("chain through definitions and factors (`kinetic = T`, `0.5*m*sum(…)`)",
           "tests/sim/models/chain_definitions.qd", "E,P"),
          ("chain, energies and forces in `for` loops", "tests/sim/models/chain_for_energies.qd", "x[1]"),
-         ("chain of `Vibration` parts (arrays of components): expanded, rows rerolled",
-          "tests/sim/models/chain_components.qd", "ms[1].s")]
+         ("chain of `Vibration` parts (arrays of components): energies summed over the connections, templates",
+          "tests/sim/models/chain_components.qd", "ms[1].s"),
+         ("chain of parallel `Spring` and `Damper` parts (three flanges a node)",
+          "tests/sim/models/parallel_chain_components.qd", "ms[1].s")]
 
 
 def forms(build, n, repeat):
