@@ -190,6 +190,38 @@ def executables(build, sizes, stop, tmp):
             print(f"| {name} | {n:,} | {bwall:.2f} | {bpeak:.0f} | {size:.2f} | {first:.3g} | {hand} |".replace(",", " "))
 
 
+PARTS = "tests/sim/models/chain_components.qd"
+
+
+def components(build, sizes, stop, repeat):
+    """The chain of Vibration parts (arrays of components) in the default mode, whole process: asked
+    for two masses (energies summed over the connections, templates), and for a link force too
+    (the parts and their flows expanded, rows rerolled), next to the spring chain written with energies
+    and the hand-written program; compile time from --stats."""
+    print(f"\n## Arrays of components as templates: the chain of `Vibration` parts, whole process "
+          f"(rtol 1e-6, {stop:g} s, default mode, best of {repeat})\n")
+    print("| n | parts, masses asked for: compile / whole [s] / peak [MiB] | parts, a link force too: compile / whole "
+          "[s] / peak [MiB] | spring chain, energies: whole [s] / peak [MiB] | hand-written: whole [s] / peak [MiB] |")
+    print("| ---: | ---: | ---: | ---: | ---: |")
+    for n in sizes:
+        masses = f"ms[1].s,ms[{n}].s"
+        runs = {"summed": [f"{build}/qdot", "run", PARTS, "-p", f"n={n}", "--outputs", masses],
+                "flows": [f"{build}/qdot", "run", PARTS, "-p", f"n={n}", "--outputs", masses + ",links[1].b.f"],
+                "chain": [f"{build}/qdot", "run", CHAIN, "-p", f"n={n}", "--outputs", f"x[1],x[{n}]"],
+                "hand": [f"{build}/bench/reference_sim", "chain", "--n", str(n), "--outputs", f"x[1],x[{n}]"]}
+        best = {}
+        for _ in range(repeat):
+            for key, command in runs.items():
+                extra = [] if key == "hand" else ["--no-progress", "--stats"]
+                wall, peak, err = peak_of(command + ["--stop", str(stop), "-o", "/dev/null"] + extra)
+                compile_s = number(r"; total ([0-9.e+-]+)", err, 0.0) / 1e3
+                old = best.get(key, (float("inf"),) * 3)
+                best[key] = tuple(min(a, b) for a, b in zip(old, (compile_s, wall, peak)))
+        cell = lambda k: f"{best[k][0]:.2f} / {best[k][1]:.2f} / {best[k][2]:.0f}"
+        print(f"| {n:,} | {cell('summed')} | {cell('flows')} | {best['chain'][1]:.2f} / {best['chain'][2]:.0f} | "
+              f"{best['hand'][1]:.2f} / {best['hand'][2]:.0f} |".replace(",", " "))
+
+
 def print_whole(rows, stop, repeat):
     print(f"\n## Whole process, issue 15's setting (rtol 1e-6, {stop:g} s, KLU, columns x[1], x[n]; "
           f"default mode; best of {repeat})\n")
@@ -216,6 +248,7 @@ def main():
     ap.add_argument("--whole-stop", type=float, default=1.0)
     ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("--forms-n", type=int, default=100000, help="n of the ways-of-writing table (0 skips it)")
+    ap.add_argument("--parts-sizes", default=None, help="n for the arrays-of-components table (default 1000,10000,100000; 'none' skips it)")
     ap.add_argument("--exe-sizes", default=None, help="n for the executables table (default 1000,100000,1000000; 'none' skips it)")
     a = ap.parse_args()
     sizes = [int(s) for s in a.sizes.split(",")] if a.sizes else ([1000, 10000, 100000] if a.quick else
@@ -245,6 +278,10 @@ def main():
     small_models(a.build, 10)
     if a.forms_n:
         forms(a.build, a.forms_n, a.repeat)
+    if a.parts_sizes != "none":
+        parts_sizes = [int(s) for s in a.parts_sizes.split(",")] if a.parts_sizes else (
+            [1000, 10000] if a.quick else [1000, 10000, 100000])
+        components(a.build, parts_sizes, a.whole_stop, a.repeat)
     if a.exe_sizes != "none":
         exe_sizes = [int(s) for s in a.exe_sizes.split(",")] if a.exe_sizes else (
             [1000, 100000] if a.quick else [1000, 100000, 1000000])
