@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
@@ -16,6 +17,7 @@
 #include "driver/Pipeline.h"
 #include "driver/WorkPrecision.h"
 #include "qdot/exit_code.hpp"
+#include "sim/Names.h"
 #include "sim/Run.h"
 
 namespace {
@@ -193,6 +195,17 @@ ExitCode run(driver::Compilation& c, Options& o) {
   return code;
 }
 
+// qdot build --outputs: every name a column of what was compiled (a variable, an output or a first
+// integral), as `qdot run` and the executable's own --outputs check theirs: a typo is an error
+// here, not an executable that silently keeps everything. "" if they all are.
+std::string unknownResult(const ModelDescription& d, const std::vector<std::string>& names) {
+  std::vector<std::string_view> columns;
+  for (const auto* list : {&d.variableNames, &d.outputNames, &d.invariantNames}) columns.insert(columns.end(), list->begin(), list->end());
+  for (const std::string& name : names)
+    if (std::find(columns.begin(), columns.end(), name) == columns.end()) return rt::unknownNameMessage("output column", name, columns);
+  return "";
+}
+
 ExitCode build(driver::Compilation& c, Options& o) {
   c.options.results = o.results;
   c.options.eliminateAlgebraics = true;  // the system `qdot run` integrates, with its loops
@@ -204,6 +217,10 @@ ExitCode build(driver::Compilation& c, Options& o) {
     return ExitCode::Usage;
   }
   if (std::optional<ExitCode> failed = compileToKernels(c, o)) return *failed;
+  if (std::string why = unknownResult(c.kernels->description, o.results); !why.empty()) {
+    std::cerr << "error: --outputs: " << why << "\n";
+    return ExitCode::Usage;
+  }
   if (!o.run.parameters.empty()) {
     std::cerr << "error: -p " << o.run.parameters.front() << ": qdot build takes values only for Integer parameters ("
               << (driver::structuralParameterList(c).empty() ? "this model has none" : driver::structuralParameterList(c))

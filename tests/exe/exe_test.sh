@@ -40,6 +40,8 @@ for backend in llvm bytecode; do
   same csv-experiment-$backend "$work/$backend-exe-default.csv" "$work/$backend-run-default.csv"
   # qdot run --outputs compiles only what the columns need (E is left out), as qdot build --outputs does.
   check "build-outputs-$backend" 0 "$qdot" build "$utube" -o "$exe-o" --backend $backend --outputs x,jacobi
+  # A name the model lacks is a usage error, as qdot run's --outputs (not an executable keeping all).
+  check "build-outputs-unknown-$backend" 2 "$qdot" build "$utube" -o "$exe-typo" --backend $backend --outputs x,jacobj
   "$exe-o" --stop 2 --interval 0.1 --rtol 1e-8 --invariants --outputs x,jacobi -o "$work/$backend-exe-o.csv"
   "$qdot" run "$utube" --backend $backend --stop 2 --interval 0.1 --rtol 1e-8 --invariants --outputs x,jacobi -o "$work/$backend-run-o.csv"
   same csv-outputs-$backend "$work/$backend-exe-o.csv" "$work/$backend-run-o.csv"
