@@ -328,7 +328,7 @@ std::string sumComponentArrays(flat::FlatModel& m, Compilation& c) {
   if (!c.options.keepLoops || firstComponentArray(m).empty()) return "";
   if (c.options.results.empty()) return "every result is asked for, the connectors' flows too";
   std::string why = flat::sumConnectedEnergies(m, c.ctx, c.options.results);
-  if (why.empty()) flat::rerollTerms(m, c.ctx, c.options.rerollMinimumRun);
+  if (why.empty()) flat::rerollTerms(m, c.ctx, c.options.rerollMinimumRun), c.componentsSummed = true;
   return why;
 }
 
@@ -368,6 +368,7 @@ bool flatten(Compilation& c) {
         model.reset();
         c.ctx.clear();
         limits.keepLoops = false;
+        c.componentsSummed = false;  // (flattened as written)
         DiagnosticEngine again;  // the same diagnostics as the first time, already reported
         model = flat::flatten(*c.checked, c.ctx, again, limits, c.options.structural);
       }

@@ -92,6 +92,9 @@ struct Compilation {
   /// Whether the model's repeated structure (sums, loops) is compiled as loops (docs/loops.md):
   /// nullopt if it has none, "" if it is, else why it is expanded to scalars (`qdot run --stats`).
   std::optional<std::string> loops;
+  /// Arrays of components whose energies were summed over their connections (flat::sumConnectedEnergies):
+  /// their connectors' flows are not computed (`qdot run --stats` says so).
+  bool componentsSummed = false;
   /// Runs of repeating rows of a model expanded to scalars made loops again (dae::rerollRows).
   dae::RerollResult rerolled;
   flat::Experiment experiment;  ///< the DAE's experiment annotation (kept when the DAE is released)

@@ -173,6 +173,9 @@ ExitCode run(driver::Compilation& c, Options& o) {
   if (o.run.stats && c.loops)
     std::cerr << (c.loops->empty() ? "loops: the model's repeated structure is compiled as loops\n"
                                    : "loops: the model's repeated structure is expanded to scalars: " + *c.loops + "\n");
+  if (o.run.stats && c.componentsSummed)
+    std::cerr << "loops: arrays of components: their energies are summed over the connections (the connectors' flows "
+                 "are not computed: ask for one with --outputs to keep them)\n";
   if (o.run.stats && c.rerolled.blocks)
     std::cerr << "loops: " << c.rerolled.rows << " of the scalar rows repeat along arrays of unknowns: rerolled into "
               << c.rerolled.blocks << (c.rerolled.blocks == 1 ? " loop\n" : " loops\n");
