@@ -649,4 +649,22 @@ void Flattener::lowerExperiment() {
     }
 }
 
+void renumberVariables(FlatModel& m, const std::vector<int>& newIndex) {
+  size_t count = static_cast<size_t>(std::count_if(newIndex.begin(), newIndex.end(), [](int k) { return k >= 0; }));
+  std::vector<Variable> vars(count);
+  for (size_t v = 0; v < m.variables.size(); ++v) {
+    if (newIndex[v] < 0) continue;
+    Variable& var = vars[newIndex[v]] = m.variables[v];
+    if (var.derivative >= 0) var.derivative = newIndex[var.derivative];
+    if (var.derivativeOf >= 0) var.derivativeOf = newIndex[var.derivativeOf];
+  }
+  m.variables = std::move(vars);
+  for (int& v : m.symbolToVariable)
+    if (v >= 0) v = newIndex[v];
+  for (auto& [q, t] : m.forces) q = newIndex[q];
+  for (auto* eqs : {&m.equations, &m.initialEquations, &m.constraints})
+    for (Equation& e : *eqs)
+      if (e.origin.variable >= 0) e.origin.variable = newIndex[e.origin.variable];
+}
+
 }  // namespace qdot::flat

@@ -61,6 +61,11 @@ void expandEquationSums(FlatModel& model, sym::Context& ctx);
 /// clears the templates.
 void expandIndexedSums(FlatModel& model, sym::Context& ctx);
 
+/// Renumbers the model's variables: variable v becomes newIndex[v], or leaves the model where it is -1
+/// (the new indices are 0..k-1, each used once). Every index of a variable follows: derivatives, the
+/// symbol table, forces' targets, equations' origins; nothing else may name a dropped variable.
+void renumberVariables(FlatModel& model, const std::vector<int>& newIndex);
+
 /// `s` or `-s` for a symbol s: (s, ±1); nullopt for anything else (an alias's value).
 std::optional<std::pair<sym::Expr, int>> signedSymbol(sym::Expr e);
 

@@ -204,27 +204,9 @@ class Reroller {
       }
       for (int w : families_[mb.family].members) order.push_back(w), placed[w] = 1;
     }
-    renumber(order);
-  }
-
-  void renumber(const std::vector<int>& order) {
     std::vector<int> newIndex(order.size());
     for (size_t k = 0; k < order.size(); ++k) newIndex[order[k]] = static_cast<int>(k);
-    std::vector<Variable> vars;
-    vars.reserve(order.size());
-    for (int v : order) {
-      Variable var = m_.variables[v];
-      if (var.derivative >= 0) var.derivative = newIndex[var.derivative];
-      if (var.derivativeOf >= 0) var.derivativeOf = newIndex[var.derivativeOf];
-      vars.push_back(var);
-    }
-    m_.variables = std::move(vars);
-    for (int& v : m_.symbolToVariable)
-      if (v >= 0) v = newIndex[v];
-    for (auto& [q, t] : m_.forces) q = newIndex[q];
-    for (auto* eqs : {&m_.equations, &m_.initialEquations, &m_.constraints})
-      for (Equation& e : *eqs)
-        if (e.origin.variable >= 0) e.origin.variable = newIndex[e.origin.variable];
+    renumberVariables(m_, newIndex);
   }
 };
 

@@ -247,26 +247,9 @@ class Summation {
     int kept = 0;
     for (size_t v = 0; v < m_.variables.size(); ++v)
       if (!aliased(static_cast<int>(v)) && !isFlow_[v]) newIndex[v] = kept++;
-    for (auto& [q, t] : forces) q = newIndex[q];
-    m_.forces = std::move(forces);
-    m_.equations.clear();  // the balances, which the summed rows fulfil
-    compact(newIndex);
-  }
-
-  // Drops the variables whose new index is -1 and renumbers the rest (their derivatives, the
-  // symbol table).
-  void compact(const std::vector<int>& newIndex) {
-    std::vector<Variable> kept;
-    for (size_t v = 0; v < m_.variables.size(); ++v) {
-      if (newIndex[v] < 0) continue;
-      Variable var = m_.variables[v];
-      if (var.derivative >= 0) var.derivative = newIndex[var.derivative];
-      if (var.derivativeOf >= 0) var.derivativeOf = newIndex[var.derivativeOf];
-      kept.push_back(var);
-    }
-    for (int& v : m_.symbolToVariable)
-      if (v >= 0) v = newIndex[v];
-    m_.variables = std::move(kept);
+    m_.forces = std::move(forces);  // (on coordinates, which stay)
+    m_.equations.clear();           // the balances, which the summed rows fulfil
+    renumberVariables(m_, newIndex);
   }
 };
 
