@@ -19,6 +19,9 @@ as templates against expanded to scalars (--no-loops, which also leaves rows unr
 Then standalone executables (`qdot build`): build time, size and the way to the first step per n
 (--exe-sizes), for the chain (next to the hand-written program) and the chain of Vibration parts.
 
+Then the time to the first step with the memory that the compiler frees reused by the solver (the
+default) and with glibc's defaults (QDOT_REUSE_FREED_MEMORY=0), side by side (--reuse-sizes).
+
 Then the whole process at issue 15's setting (rtol 1e-6, 1 s, KLU, columns x[1] and x[n]) for
 n = 10^3 ... 10^5 (--whole-sizes): `qdot run` in its default mode (tiering) against the hand-written
 program, wall time and peak memory, best of --repeat runs (one fresh process each).
@@ -35,18 +38,22 @@ CHAIN = "examples/vibration/spring_chain.qd"
 STAGES = ["flatten", "derive", "dae", "kernel"]
 
 
-def peak_of(command):
+def peak_of(command, env=None, faults=None):
     # ru_maxrss of RUSAGE_CHILDREN is the largest child so far: measure each run in its own
-    # Python child so earlier (bigger) runs do not hide it.
+    # Python child so earlier (bigger) runs do not hide it. faults: a list that gets the run's page
+    # faults (ru_minflt: pages first touched).
     code = ("import resource,subprocess,sys,time;t=time.perf_counter();"
             "p=subprocess.run(sys.argv[1:],stdout=subprocess.DEVNULL,stderr=subprocess.PIPE,text=True);"
-            "w=time.perf_counter()-t;"
-            "print(w, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss/1024.0, p.returncode);"
+            "w=time.perf_counter()-t;u=resource.getrusage(resource.RUSAGE_CHILDREN);"
+            "print(w, u.ru_maxrss/1024.0, p.returncode, u.ru_minflt);"
             "sys.stderr.write(p.stderr)")
-    p = subprocess.run([sys.executable, "-c", code] + command, capture_output=True, text=True)
-    wall, peak, rc = p.stdout.split()
+    p = subprocess.run([sys.executable, "-c", code] + command, capture_output=True, text=True,
+                       env=None if env is None else {**os.environ, **env})
+    wall, peak, rc, minflt = p.stdout.split()
     if int(rc) != 0:
         sys.exit(f"failed ({rc}): {' '.join(command)}\n{p.stderr}")
+    if faults is not None:
+        faults.append(int(minflt))
     return float(wall), float(peak), p.stderr
 
 
@@ -55,10 +62,11 @@ def number(pattern, text, default=float("nan")):
     return float(m.group(1)) if m else default
 
 
-def measure(build, n, stop):
+def measure(build, n, stop, env=None):
     qdot = [f"{build}/qdot", "run", CHAIN, "-p", f"n={n}", "--stop", str(stop), "--interval", str(stop),
             "--outputs", "x[1]", "-o", "/dev/null", "--stats", "--jit-wait", "--no-progress"]
-    wall, peak, err = peak_of(qdot)
+    faults = []
+    wall, peak, err = peak_of(qdot, env, faults)
     stages = {s: number(rf"{s} ([0-9.e+-]+)", err) / 1e3 for s in STAGES}
     stages["codegen"] = number(r"codegen \([^)]*\) ([0-9.e+-]+)", err) / 1e3
     setup = number(r"setup ([0-9.e+-]+) s", err)
@@ -71,9 +79,34 @@ def measure(build, n, stop):
     hstep1 = number(r"first step ([0-9.e+-]+) s", herr)
     # file -> first step: the whole process but the solve after IDA's first completed step (its
     # first matrix factorization, KLU's analysis included, belongs to the way there).
-    return {"n": n, "wall": wall, "peak": peak, "setup": setup, "solve": solve, "step1": step1, **stages,
+    return {"n": n, "wall": wall, "peak": peak, "faults": faults[0], "setup": setup, "solve": solve, "step1": step1,
+            **stages,
             "first": wall - solve + step1, "hwall": hwall, "hpeak": hpeak,
             "hfirst": hwall - number(r"solve ([0-9.e+-]+) s", herr) + hstep1, "hsetup": hsetup, "hstep1": hstep1}
+
+
+def reuse(build, sizes, stop, repeat):
+    """File -> first step with freed memory reused (the default, runtime/sim/MemoryReuse.h) and with
+    glibc's defaults (QDOT_REUSE_FREED_MEMORY=0), alternating, best of `repeat` by file -> first step."""
+    print(f"\n## Freed memory reused: the spring chain from the file to the first step (horizon {stop:g} s, "
+          f"--jit-wait, best of {repeat})\n")
+    print("| n | glibc's defaults: compile / IDA setup / first step / **file → first step** [s] | peak [MiB] | "
+          "page faults | reused: compile / IDA setup / first step / **file → first step** [s] | peak [MiB] | "
+          "page faults | **time ratio** | hand-written: **start → first step** [s] |")
+    print("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for n in sizes:
+        runs = {"off": [], "on": []}
+        for _ in range(repeat):
+            runs["off"].append(measure(build, n, stop, {"QDOT_REUSE_FREED_MEMORY": "0"}))
+            runs["on"].append(measure(build, n, stop))
+        best = {k: min(v, key=lambda r: r["first"]) for k, v in runs.items()}
+
+        def cells(r):
+            compile_ = sum(r[s] for s in STAGES) + r["codegen"]
+            return (f"{compile_:.2f} / {r['setup']:.2f} / {r['step1']:.2f} / **{r['first']:.2f}** | {r['peak']:.0f} | "
+                    f"{r['faults']:,}".replace(",", " "))
+        print(f"| {n:,} | {cells(best['off'])} | {cells(best['on'])} | **{best['on']['first'] / best['off']['first']:.2f}** "
+              f"| {min(r['hfirst'] for r in runs['on']):.2f} |".replace(",", " "))
 
 
 def whole(build, n, stop, repeat):
@@ -250,6 +283,8 @@ def main():
     ap.add_argument("--forms-n", type=int, default=100000, help="n of the ways-of-writing table (0 skips it)")
     ap.add_argument("--parts-sizes", default=None, help="n for the arrays-of-components table (default 1000,10000,100000; 'none' skips it)")
     ap.add_argument("--exe-sizes", default=None, help="n for the executables table (default 1000,100000,1000000; 'none' skips it)")
+    ap.add_argument("--reuse-sizes", default=None,
+                    help="n for the freed-memory table (default 100000,1000000, with --quick 100000; 'none' skips it)")
     a = ap.parse_args()
     sizes = [int(s) for s in a.sizes.split(",")] if a.sizes else ([1000, 10000, 100000] if a.quick else
                                                                    [1000, 10000, 100000, 1000000])
@@ -286,6 +321,10 @@ def main():
         exe_sizes = [int(s) for s in a.exe_sizes.split(",")] if a.exe_sizes else (
             [1000, 100000] if a.quick else [1000, 100000, 1000000])
         executables(a.build, exe_sizes, a.stop, os.environ.get("TMPDIR", "/tmp"))
+    if a.reuse_sizes != "none":
+        reuse_sizes = [int(s) for s in a.reuse_sizes.split(",")] if a.reuse_sizes else (
+            [100000] if a.quick else [100000, 1000000])
+        reuse(a.build, reuse_sizes, a.stop, max(a.repeat, 2))
     if a.whole_sizes != "none":
         whole_sizes = [int(s) for s in a.whole_sizes.split(",")] if a.whole_sizes else (
             [1000, 10000] if a.quick else [1000, 10000, 100000])

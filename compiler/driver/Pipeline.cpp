@@ -10,9 +10,6 @@
 #include <chrono>
 #include <iostream>
 #include <iterator>
-#ifdef __GLIBC__
-#include <malloc.h>  // malloc_trim
-#endif
 
 #include "bodies/RigidBodies.h"
 #include "bytecode/Emitter.h"
@@ -273,14 +270,6 @@ bool readsIterators(const flat::FlatModel& m, const sym::Context& ctx) {
   return false;
 }
 
-// Gives the pages of freed blocks back to the system, so that what the solver allocates next
-// does not add to the compiler's peak (glibc keeps freed heap pages otherwise).
-void returnFreedMemory() {
-#ifdef __GLIBC__
-  malloc_trim(0);
-#endif
-}
-
 // Whether `for` equations may stay templates (docs/loops.md), from the syntax: a run that keeps
 // loops, of a model of equations only — no mechanics or components (initial
 // equations that are start values are checked on the flat model) — with `for` loops of equations naming at most one derivative each (`der(x[i]) = …`,
@@ -404,7 +393,7 @@ bool buildDae(Compilation& c) {
   });
   if (c.dae) c.experiment = c.dae->experiment;
   bool ok = c.dae && !c.diags.hasErrors();
-  if (ok && c.options.releaseStages) c.eom.reset(), c.flat.reset(), returnFreedMemory();
+  if (ok && c.options.releaseStages) c.eom.reset(), c.flat.reset();
   return ok;
 }
 
@@ -416,7 +405,6 @@ bool buildKernels(Compilation& c) {
   if (ok && c.options.releaseStages) {  // the kernels hold no symbolic nodes
     c.dae.reset();
     c.ctx.clear();
-    returnFreedMemory();
   }
   return ok;
 }

@@ -17,6 +17,7 @@
 #include "driver/Pipeline.h"
 #include "driver/WorkPrecision.h"
 #include "qdot/exit_code.hpp"
+#include "sim/MemoryReuse.h"
 #include "sim/Names.h"
 #include "sim/Run.h"
 
@@ -312,6 +313,7 @@ CLI::App* addCommand(CLI::App& app, const char* name, const char* help, Options&
 }  // namespace
 
 int main(int argc, char** argv) {
+  rt::reuseFreedMemory();  // the compiler's freed stages become the solver's memory (sim/MemoryReuse.h)
   CLI::App app{"qdot — a compiler for mechanics models (.qd): derives the equations of motion and solves them"};
   app.set_version_flag("--version", std::string("qdot ") + QDOT_VERSION);
   app.require_subcommand(1);

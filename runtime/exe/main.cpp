@@ -17,6 +17,7 @@
 
 #include "exe/Embedded.h"
 #include "exe/NativeModel.h"
+#include "sim/MemoryReuse.h"
 #include "sim/Names.h"
 #include "sim/Run.h"
 #include "vm/Runs.h"
@@ -127,6 +128,7 @@ std::string structuralAssignment(const std::vector<std::string>& fixed, const st
 }  // namespace
 
 int main(int argc, char** argv) {
+  rt::reuseFreedMemory();  // reading the module frees what the solver then needs (sim/MemoryReuse.h)
   std::span<const uint8_t> bytes(qdot_model_bytes, qdot_model_size);
   // Native code for the programs that run per step, or none (built with --backend bytecode).
   bool native = std::any_of(qdot_native_programs, qdot_native_programs + kModelProgramCount,

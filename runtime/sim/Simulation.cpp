@@ -18,6 +18,7 @@
 #include "ida/ModelCheck.h"
 #include "output/AngleUnwrap.h"
 #include "sim/Names.h"
+#include "sim/MemoryReuse.h"
 #include "sim/PeakMemory.h"
 
 namespace qdot::rt {
@@ -280,6 +281,9 @@ SimulationResult simulateWith(const QdotModel& model, const SimulationSettings& 
     for (std::size_t k = 0; k < grid.size(); ++k) {
       double t = k == 0 ? session->time() : advanceWithin(settings, *session, grid[k]);
       sink.row(t, rows.build(t, session->y(), session->yp()));
+      // The setup and the first steps have allocated what the solver needs, reusing what the
+      // process freed before (sim/MemoryReuse.h): the rest goes back to the system.
+      if (k == 1) returnFreedMemory();
       ++result.rows;
       result.lastRowTime = t;
       checkStepLimit(settings, *session);

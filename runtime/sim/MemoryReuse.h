@@ -1,0 +1,47 @@
+// How a qdot process treats the memory it frees before the solve (issue 15).
+//
+// A large model's compile frees most of what it allocated (each stage's input once the next has
+// what it needs, driver::CompileOptions::releaseStages), and the integrator's setup and first step
+// then allocate hundreds of MB (IDA's vectors, KLU's matrix and factors). glibc serves blocks of
+// 128 KiB–32 MiB and more by mmap and gives them back on free, so every one of those pages was
+// faulted in, zeroed by the kernel and unmapped, only for the solver to fault in new ones: on this
+// project's machines first touching memory costs 0.5–1.8 s per GiB, a third to a half of the
+// 10⁶-mass chain's time to its first step (bench/README.md, "Freed memory reused").
+//
+// reuseFreedMemory() (at the start of `qdot` and of the executables it builds) makes every block
+// come from the heap and keeps freed pages there, so later stages and the solver reuse pages that
+// are already mapped; returnFreedMemory() (after the solver's first steps, runtime/sim/Simulation.cpp)
+// gives back what is still free, so a long run does not hold the compiler's leftovers. Only the
+// time to fault pages changes; every result is the same to the bit.
+#pragma once
+
+#include <climits>
+#include <cstdlib>
+#include <string_view>
+
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
+namespace qdot::rt {
+
+/// Blocks of any size from the heap, and no trimming of freed pages until returnFreedMemory().
+/// Call once, before the process allocates much. (Where glibc cannot map more heap it still maps
+/// blocks one by one, so this cannot make an allocation fail.) QDOT_REUSE_FREED_MEMORY=0 in the
+/// environment leaves glibc's defaults, for measuring the difference (bench/scaling_bench.py).
+inline void reuseFreedMemory() {
+#if defined(__GLIBC__)
+  if (const char* v = std::getenv("QDOT_REUSE_FREED_MEMORY"); v && std::string_view(v) == "0") return;
+  mallopt(M_MMAP_MAX, 0);
+  mallopt(M_TRIM_THRESHOLD, INT_MAX);  // free() trims the heap's top only beyond this (the largest value)
+#endif
+}
+
+/// Gives the pages of freed blocks back to the system.
+inline void returnFreedMemory() {
+#if defined(__GLIBC__)
+  malloc_trim(0);
+#endif
+}
+
+}  // namespace qdot::rt
