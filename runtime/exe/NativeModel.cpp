@@ -56,4 +56,6 @@ Result<ModelPtr> createNativeModel(std::span<const uint8_t> bytes, const qdot_pr
   return ModelPtr(m.release());
 }
 
+const bc::Module& moduleOf(const QdotModel& model) { return *static_cast<const NativeModel&>(model).module; }
+
 }  // namespace qdot::exe

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "exe/Embedded.h"
+#include "qdot/bytecode.h"
 #include "qdot/model_abi.h"
 #include "qdot/result.hpp"
 
@@ -16,5 +17,8 @@ namespace qdot::exe {
 /// of scratch each), or why the bytes are not a valid module.
 Result<ModelPtr> createNativeModel(std::span<const uint8_t> bytes, const qdot_program_fn programs[kModelProgramCount],
                                    const uint32_t spill[kModelProgramCount]);
+/// The module a model made by createNativeModel reads its description from (valid as long as the
+/// model), as vm::moduleOf for the VM's.
+const bc::Module& moduleOf(const QdotModel& model);
 
 }  // namespace qdot::exe

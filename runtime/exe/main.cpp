@@ -145,9 +145,14 @@ int main(int argc, char** argv) {
                            model->name ? model->name : "model")};
   rt::RunOptions options;
   rt::addRunOptions(app, options);
-  Result<bc::Module> module = bc::deserialize(bytes);
-  std::vector<std::string> fixed = module ? module->description.structuralParameters : std::vector<std::string>{};
-  app.footer(parameterHelp(*model) + structuralHelp(fixed));
+  // The module the model already read (not a second copy: a large model's is most of the process).
+  const bc::Module& module = native ? exe::moduleOf(*model) : vm::moduleOf(*model);
+  const std::vector<std::string>& fixed = module.description.structuralParameters;
+  app.footer([&] {  // made for --help only; CLI11 adds a newline after it
+    std::string help = parameterHelp(*model) + structuralHelp(fixed);
+    if (help.ends_with('\n')) help.pop_back();
+    return help;
+  });
   int code = 0;
   try {
     app.parse(argc, argv);
