@@ -16,6 +16,7 @@
 #include "dae/IndexReduction.h"
 #include "dae/TemplateOde.h"
 #include "flatten/FlatPrinter.h"
+#include "sim/Names.h"
 #include "syntax/Parser.h"
 
 namespace qdot::driver {
@@ -309,6 +310,24 @@ std::string firstComponentArray(const flat::FlatModel& m) {
   return "";
 }
 
+// A result asked for that is no variable or output of the flat model but near a variable's name is
+// most likely a typo (`links[3].b.ff`). The components are then left as they are: summing would
+// drop the flows it may be a typo of, and the error that follows could not suggest the right name.
+// (A name far from every variable, such as an invariant's, `jacobi`, is resolved later.)
+std::string misspeltResult(const flat::FlatModel& m, const Compilation& c) {
+  for (const std::string& name : c.options.results) {
+    sym::Expr s = c.ctx.findSymbol(name);
+    if ((s && m.variableOf(s) >= 0) ||
+        std::any_of(m.outputs.begin(), m.outputs.end(), [&](const flat::Output& o) { return o.name == name; }))
+      continue;
+    std::vector<std::string_view> names;
+    names.reserve(m.variables.size());
+    for (const flat::Variable& v : m.variables) names.push_back(v.name);
+    if (rt::closestName(name, names)) return "'" + name + "', asked for, is not a result of the model";
+  }
+  return "";
+}
+
 // A run of a model with arrays of components that asks for some results only (`qdot run --outputs`):
 // its components' energies summed over their connections (flat::sumConnectedEnergies), a
 // Lagrangian over the coordinates whose repeated structure can stay templates. Returns why not
@@ -316,6 +335,7 @@ std::string firstComponentArray(const flat::FlatModel& m) {
 std::string sumComponentArrays(flat::FlatModel& m, Compilation& c) {
   if (!c.options.keepLoops || firstComponentArray(m).empty()) return "";
   if (c.options.results.empty()) return "every result is asked for, the connectors' flows too";
+  if (std::string why = misspeltResult(m, c); !why.empty()) return why;
   std::string why = flat::sumConnectedEnergies(m, c.ctx, c.options.results);
   if (why.empty()) flat::rerollTerms(m, c.ctx, c.options.rerollMinimumRun), c.componentsSummed = true;
   return why;

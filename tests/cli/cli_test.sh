@@ -70,6 +70,10 @@ contains binary-file-says "this is not a text file" "$qdot" check /tmp/qdot_cli_
 rm -f /tmp/qdot_cli_binary.$$.qd
 contains csv-names-identifier "time,th_1," "$qdot" run "$src/examples/pendulum/nlink.qd" --stop 0.01 --csv-names=identifier
 check csv-names-bad 2 "$qdot" run "$src/examples/pendulum/nlink.qd" --csv-names=python
+# A misspelt flow of a chain of parts asked for: a usage error that suggests the flow (the parts are
+# not summed for a name that is near one of their variables).
+check outputs-misspelt-flow 2 "$qdot" run "$src/tests/sim/models/chain_components.qd" -p n=5 --outputs 'links[3].b.ff'
+contains outputs-misspelt-flow-suggests "did you mean 'links[3].b.f'?" "$qdot" run "$src/tests/sim/models/chain_components.qd" -p n=5 --outputs 'links[3].b.ff'
 check parameter-out-of-range 2 "$qdot" run "$src/examples/textbook/utube.qd" -p rho=1e400
 contains parameter-out-of-range-says "out of range" "$qdot" run "$src/examples/textbook/utube.qd" -p rho=1e400
 # --outputs: only what the results need (the oscillator of two uncoupled subsystems).

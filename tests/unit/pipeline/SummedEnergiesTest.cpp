@@ -132,6 +132,22 @@ TEST(SummedEnergies, AFlowAskedForKeepsTheParts) {
   EXPECT_LT(run.c.dae->stateCount(), run.c.dae->variables.size());  // flows among the unknowns
 }
 
+// A result that is no variable but one letter from a flow (a typo): the parts stay as they are, so
+// that the run's error can suggest the flow; a name far from every variable does not stop the sum.
+TEST(SummedEnergies, AMisspeltFlowKeepsTheParts) {
+  PartsRun misspelt(kParts, {"ms[1].s", "links[3].b.ff"}, driver::Stage::Flatten, 4);
+  ASSERT_TRUE(misspelt.ok);
+  EXPECT_NE(misspelt.c.loops->find("'links[3].b.ff', asked for, is not a result of the model"), std::string::npos)
+      << *misspelt.c.loops;
+  EXPECT_FALSE(misspelt.c.componentsSummed);
+  EXPECT_TRUE(misspelt.c.flat->indexedSums.empty());
+  EXPECT_GE(misspelt.c.flat->variableOf(misspelt.c.ctx.findSymbol("links[3].b.f")), 0);  // the flow is still there
+  PartsRun far(kParts, {"ms[1].s", "jacobi"}, driver::Stage::Flatten, 4);
+  ASSERT_TRUE(far.ok);
+  EXPECT_TRUE(far.c.componentsSummed);
+  EXPECT_EQ(far.c.flat->indexedSums.size(), 2u);
+}
+
 // A part whose equations read its flows (a spring written as equations): nothing is summed.
 TEST(SummedEnergies, APartWithEquationsOverItsFlowsKeepsTheParts) {
   std::string text = kParts;
