@@ -315,14 +315,14 @@ std::string firstComponentArray(const flat::FlatModel& m) {
 // drop the flows it may be a typo of, and the error that follows could not suggest the right name.
 // (A name far from every variable, such as an invariant's, `jacobi`, is resolved later.)
 std::string misspeltResult(const flat::FlatModel& m, const Compilation& c) {
+  std::vector<std::string_view> names;  // made for the first name that is not found
   for (const std::string& name : c.options.results) {
     sym::Expr s = c.ctx.findSymbol(name);
     if ((s && m.variableOf(s) >= 0) ||
         std::any_of(m.outputs.begin(), m.outputs.end(), [&](const flat::Output& o) { return o.name == name; }))
       continue;
-    std::vector<std::string_view> names;
-    names.reserve(m.variables.size());
-    for (const flat::Variable& v : m.variables) names.push_back(v.name);
+    if (names.empty())
+      for (const flat::Variable& v : m.variables) names.push_back(v.name);
     if (rt::closestName(name, names)) return "'" + name + "', asked for, is not a result of the model";
   }
   return "";
