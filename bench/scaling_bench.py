@@ -19,8 +19,9 @@ as templates against expanded to scalars (--no-loops, which also leaves rows unr
 Then standalone executables (`qdot build`): build time, size and the way to the first step per n
 (--exe-sizes), for the chain (next to the hand-written program) and the chain of Vibration parts.
 
-Then the time to the first step with the memory that the compiler frees reused by the solver (the
-default) and with glibc's defaults (QDOT_REUSE_FREED_MEMORY=0), side by side (--reuse-sizes).
+Then the time to the first step with glibc's defaults (QDOT_REUSE_FREED_MEMORY=0), with the memory
+that the compiler frees reused by the solver (QDOT_PREFAULT_HEAP=0), and as qdot runs by default
+(reused, and the heap prefaulted by a second thread), side by side (--reuse-sizes).
 
 Then the whole process at issue 15's setting (rtol 1e-6, 1 s, KLU, columns x[1] and x[n]) for
 n = 10^3 ... 10^5 (--whole-sizes): `qdot run` in its default mode (tiering) against the hand-written
@@ -86,27 +87,30 @@ def measure(build, n, stop, env=None):
 
 
 def reuse(build, sizes, stop, repeat):
-    """File -> first step with freed memory reused (the default, runtime/sim/MemoryReuse.h) and with
-    glibc's defaults (QDOT_REUSE_FREED_MEMORY=0), alternating, best of `repeat` by file -> first step."""
-    print(f"\n## Freed memory reused: the spring chain from the file to the first step (horizon {stop:g} s, "
+    """File -> first step three ways, alternating, best of `repeat` by file -> first step: glibc's
+    defaults (QDOT_REUSE_FREED_MEMORY=0), freed memory reused without the heap prefaulter
+    (QDOT_PREFAULT_HEAP=0), and qdot's default (reused, prefaulter on; runtime/sim/MemoryReuse.h)."""
+    variants = [("glibc", {"QDOT_REUSE_FREED_MEMORY": "0"}), ("reused", {"QDOT_PREFAULT_HEAP": "0"}), ("default", None)]
+    print(f"\n## Freed memory reused, heap prefaulted: the spring chain from the file to the first step (horizon {stop:g} s, "
           f"--jit-wait, best of {repeat})\n")
-    print("| n | glibc's defaults: compile / IDA setup / first step / **file → first step** [s] | peak [MiB] | "
-          "page faults | reused: compile / IDA setup / first step / **file → first step** [s] | peak [MiB] | "
-          "page faults | **time ratio** | hand-written: **start → first step** [s] |")
-    print("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    print("| n | way | compile / IDA setup / first step / **file → first step** [s] | peak [MiB] | page faults "
+          "| **time / glibc's defaults** | hand-written: **start → first step** [s] |")
+    print("| ---: | --- | ---: | ---: | ---: | ---: | ---: |")
+    names = {"glibc": "glibc's defaults", "reused": "freed memory reused",
+             "default": "reused + heap prefaulted (default)"}
     for n in sizes:
-        runs = {"off": [], "on": []}
+        runs = {k: [] for k, _ in variants}
         for _ in range(repeat):
-            runs["off"].append(measure(build, n, stop, {"QDOT_REUSE_FREED_MEMORY": "0"}))
-            runs["on"].append(measure(build, n, stop))
+            for key, env in variants:
+                runs[key].append(measure(build, n, stop, env))
         best = {k: min(v, key=lambda r: r["first"]) for k, v in runs.items()}
-
-        def cells(r):
+        hand = min(r["hfirst"] for v in runs.values() for r in v)
+        for key, _ in variants:
+            r = best[key]
             compile_ = sum(r[s] for s in STAGES) + r["codegen"]
-            return (f"{compile_:.2f} / {r['setup']:.2f} / {r['step1']:.2f} / **{r['first']:.2f}** | {r['peak']:.0f} | "
-                    f"{r['faults']:,}".replace(",", " "))
-        print(f"| {n:,} | {cells(best['off'])} | {cells(best['on'])} | **{best['on']['first'] / best['off']['first']:.2f}** "
-              f"| {min(r['hfirst'] for r in runs['on']):.2f} |".replace(",", " "))
+            print(f"| {n:,} | {names[key]} | {compile_:.2f} / {r['setup']:.2f} / {r['step1']:.2f} / **{r['first']:.2f}** "
+                  f"| {r['peak']:.0f} | {r['faults']:,} | **{r['first'] / best['glibc']['first']:.2f}** "
+                  f"| {hand:.2f} |".replace(",", " "))
 
 
 def whole(build, n, stop, repeat):

@@ -411,11 +411,11 @@ std::optional<Value> Flattener::numericComprehension(const ComprehensionExpr& e)
     v.shape.push_back(static_cast<int>(ranges.back().count));
     count *= ranges.back().count;
   }
-  v.elems.reserve(count);
-  ctx_.reserve(0, count);
+  std::vector<double> values;
+  values.reserve(count);
   std::vector<double> at(ranges.size());
   auto walk = [&](auto& self, size_t k) -> void {
-    if (k == ranges.size()) return v.elems.push_back(ctx_.constant(foldNumeric(*e.body, e.iterators, at)));
+    if (k == ranges.size()) return values.push_back(foldNumeric(*e.body, e.iterators, at));
     countScalars(ranges[k].count, e.iterators[k].range->range);  // as for a loop
     for (size_t i = 0; i < ranges[k].count; ++i) {
       at[k] = asConstant(ranges[k].first + static_cast<long>(i) * ranges[k].step);
@@ -423,6 +423,7 @@ std::optional<Value> Flattener::numericComprehension(const ComprehensionExpr& e)
     }
   };
   walk(walk, 0);
+  v.elems = ExprList(ctx_.constants(values));
   return v;
 }
 

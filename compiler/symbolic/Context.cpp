@@ -175,6 +175,30 @@ Expr Context::constant(double v) {
   return slot.node;
 }
 
+std::vector<Expr> Context::constants(std::span<const double> values) {
+  constexpr size_t kAhead = 16;
+  impl_->reserve(0, values.size());  // the table does not move while it is read ahead
+  std::vector<uint64_t> hashes(values.size());
+  for (size_t i = 0; i < values.size(); ++i) {
+    Node key{};
+    key.kind = Kind::Constant;
+    key.value = normalizeNumber(values[i]);
+    computeDerived(key);
+    hashes[i] = key.hash;
+  }
+  std::vector<Expr> out;
+  out.reserve(values.size());
+  size_t mask = impl_->tableSize - 1;
+  for (size_t i = 0; i < values.size(); ++i) {
+    if (i + kAhead < values.size()) __builtin_prefetch(&impl_->table[hashes[i + kAhead] & mask]);
+    Node key{};
+    key.kind = Kind::Constant;
+    key.value = values[i];
+    out.push_back(impl_->intern(key));
+  }
+  return out;
+}
+
 void Context::reserve(size_t symbols, size_t nodes) { impl_->reserve(symbols, nodes); }
 
 Expr Context::symbol(std::string_view name) {

@@ -90,6 +90,9 @@ class Context {
 
   // --- leaves -----------------------------------------------------------------------------
   Expr constant(double v);
+  /// constant(v) for each value, in order. For many values at once (a large array's start values):
+  /// the intern table is read ahead, so the lookups' cache misses overlap.
+  std::vector<Expr> constants(std::span<const double> values);
   Expr zero() const { return zero_; }
   Expr one() const { return one_; }
   /// A new symbol, or the existing one with this name (names are unique per Context).
