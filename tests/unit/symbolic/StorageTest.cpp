@@ -200,3 +200,25 @@ TEST(Storage, ClearGivesAContextAsNew) {
   EXPECT_EQ(used.diff(e, x)->hash, fresh.diff(fe, fx)->hash);
   EXPECT_EQ(used.add(used.mul(x, y), used.mul(y, x)), used.scale(2, used.mul(x, y)));
 }
+
+// Context::constants (a large array's start values at once) gives the nodes constant() gives one by
+// one: the same node for the same value (across the batch and before it), -0 as 0, every value exact.
+TEST(Storage, ConstantsInOneBatchAreTheConstantsOneByOne) {
+  Context ctx;
+  Expr before = ctx.constant(0.25);
+  std::vector<double> values;
+  for (int i = 0; i < 5000; ++i) values.push_back(0.01 * (i % 1700) - 3.0);
+  values.insert(values.end(), {0.25, -0.0, 0.0, std::numeric_limits<double>::infinity(), 1e-300});
+  std::vector<Expr> batch = ctx.constants(values);
+  ASSERT_EQ(batch.size(), values.size());
+  for (size_t i = 0; i < values.size(); ++i) {
+    ASSERT_TRUE(batch[i]->isConstant());
+    EXPECT_EQ(batch[i], ctx.constant(values[i])) << i;
+    EXPECT_EQ(batch[i]->value, values[i] == 0 ? 0.0 : values[i]) << i;
+  }
+  EXPECT_EQ(batch[values.size() - 5], before);
+  EXPECT_EQ(batch[values.size() - 4], ctx.zero());
+  EXPECT_EQ(batch[values.size() - 3], ctx.zero());
+  EXPECT_EQ(batch[0], batch[1700]);
+  EXPECT_TRUE(ctx.constants({}).empty());
+}
