@@ -216,6 +216,7 @@ ExitCode build(driver::Compilation& c, Options& o) {
   c.options.keepLoops = true;
   c.options.rerollRows = true;
   c.options.keepInvariants = o.run.invariants;  // as qdot run --invariants
+  c.options.releaseStages = true;  // what is built is the kernels, the bytecode and the experiment
   if (std::string why = driver::checkOutputPath(o.exe.outputPath); !why.empty()) {
     std::cerr << "qdot: error: cannot write the executable: " << why << "\n";
     return ExitCode::Usage;
