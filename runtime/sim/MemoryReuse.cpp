@@ -7,11 +7,14 @@
 #include <condition_variable>
 #include <cstdint>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <vector>
 
 #if defined(__linux__) && defined(__GLIBC__)
+#include <malloc.h>
 #include <sys/mman.h>
+#include <sys/resource.h>
 #include <unistd.h>
 #if defined(MADV_POPULATE_WRITE)
 #define QDOT_HEAP_PREFAULT 1
@@ -39,7 +42,9 @@ class HeapPrefaulter {
   void start() {
     if (thread_.joinable()) return;
     stop_ = false;
-    uintptr_t base = heapTop() & ~(kWindow - 1);  // now: what the caller allocates next is above it
+    // From now: what the caller allocates next is above it. Rounded up, as mincore fails on a range
+    // with unmapped pages (the heap starts at a page, not a window).
+    uintptr_t base = (heapTop() + kWindow - 1) & ~(kWindow - 1);
     thread_ = std::thread([this, base] { run(base); });
   }
   void stop() {
@@ -55,34 +60,33 @@ class HeapPrefaulter {
 
  private:
   static constexpr uintptr_t kWindow = uintptr_t{2} << 20;
-  static constexpr size_t kLead = 16;
+  static constexpr size_t kLead = 16;  ///< windows populated after a touched one, at most (a sixteenth of the heap)
+  static constexpr uintptr_t kPadFrom = uintptr_t{256} << 20;
+  static constexpr uintptr_t kTopPad = uintptr_t{64} << 20;
 
   // sbrk(0) only reads the current break.
   static uintptr_t heapTop() { return reinterpret_cast<uintptr_t>(sbrk(0)); }
 
+  // Page faults taken so far by the process's other threads (what this thread populates counts as
+  // its own). Unchanged since the last look: nobody touched new memory, nothing to look for.
+  static long othersFaults() {
+    rusage all{}, own{};
+    if (getrusage(RUSAGE_SELF, &all) != 0 || getrusage(RUSAGE_THREAD, &own) != 0) return -1;
+    return all.ru_minflt - own.ru_minflt;
+  }
+
   void run(uintptr_t base) {
-    const uintptr_t page = static_cast<uintptr_t>(sysconf(_SC_PAGESIZE));
-    std::vector<char> done;  // per window: populated here, or found touched
     auto pause = std::chrono::microseconds(250);
+    long seen = -2;
     std::unique_lock lock(mutex_);
     while (!stop_) {
       lock.unlock();
-      uintptr_t top = heapTop() & ~(page - 1);
-      if (top > base) done.resize((top - base + kWindow - 1) / kWindow, 0);
       bool populated = false;
-      for (size_t w = 0; w < done.size() && !stop_; ++w) {
-        if (done[w]) continue;
-        uintptr_t begin = base + w * kWindow;
-        unsigned char resident = 0;
-        if (begin >= top || mincore(reinterpret_cast<void*>(begin), page, &resident) != 0 || !(resident & 1)) continue;
-        size_t last = std::min(done.size(), w + 1 + kLead);
-        uintptr_t end = std::min(top, base + last * kWindow);
-        // Fails where unsupported (before Linux 5.14) or where the heap shrank meanwhile: then the
-        // process faults its pages in itself, as without this thread.
-        if (madvise(reinterpret_cast<void*>(begin), end - begin, MADV_POPULATE_WRITE) != 0) return;
-        std::fill(done.begin() + static_cast<long>(w), done.begin() + static_cast<long>(last), 1);
-        w = last - 1;
-        populated = true;
+      if (long faults = othersFaults(); faults != seen || faults < 0) {
+        seen = faults;
+        std::optional<bool> found = populateTouchedWindows(base);
+        if (!found) return;
+        populated = *found;
       }
       // Idle (a small model, or the solver running in memory already there): look less often.
       pause = populated ? std::chrono::microseconds(250) : std::min(2 * pause, std::chrono::microseconds(2000));
@@ -91,6 +95,42 @@ class HeapPrefaulter {
     }
   }
 
+  // One look at the heap's residency (one mincore from the first window not done to the top):
+  // populates every window touched since the last look and its lead. Whether it populated any;
+  // nullopt where populating fails (before Linux 5.14, or where the heap shrank meanwhile: then the
+  // process faults its pages in itself, as without this thread).
+  std::optional<bool> populateTouchedWindows(uintptr_t base) {
+    const uintptr_t page = static_cast<uintptr_t>(sysconf(_SC_PAGESIZE));
+    uintptr_t top = heapTop() & ~(page - 1);
+    if (top <= base) return false;
+    done_.resize((top - base + kWindow - 1) / kWindow, 0);
+    // A large heap grows by large blocks (the symbolic arena's chunks, tables, vectors): let the
+    // heap's top run ahead of them, so that the lead covers the next block before it is allocated.
+    if (!topPadded_ && top - base >= kPadFrom) topPadded_ = mallopt(M_TOP_PAD, static_cast<int>(kTopPad)) == 1;
+    const size_t lead = std::clamp<size_t>(done_.size() / 16, 1, kLead);
+    size_t first = static_cast<size_t>(std::find(done_.begin(), done_.end(), 0) - done_.begin());
+    uintptr_t from = base + first * kWindow;
+    if (from >= top) return false;
+    resident_.resize((top - from) / page);
+    if (mincore(reinterpret_cast<void*>(from), top - from, resident_.data()) != 0) return false;
+    bool populated = false;
+    for (size_t w = first; w < done_.size() && !stop_; ++w) {
+      uintptr_t begin = base + w * kWindow;
+      if (begin >= top) break;
+      if (done_[w] || !(resident_[(begin - from) / page] & 1)) continue;
+      size_t last = std::min(done_.size(), w + 1 + lead);
+      uintptr_t end = std::min(top, base + last * kWindow);
+      if (madvise(reinterpret_cast<void*>(begin), end - begin, MADV_POPULATE_WRITE) != 0) return std::nullopt;
+      std::fill(done_.begin() + static_cast<long>(w), done_.begin() + static_cast<long>(last), 1);
+      w = last - 1;
+      populated = true;
+    }
+    return populated;
+  }
+
+  bool topPadded_ = false;
+  std::vector<char> done_;                ///< per window: populated here, or found touched
+  std::vector<unsigned char> resident_;  ///< mincore's answer, per page from the first window not done
   std::thread thread_;
   std::mutex mutex_;
   std::condition_variable wake_;
