@@ -17,8 +17,8 @@
 // chain's compile): so reuseFreedMemory() also starts the heap prefaulter, a thread that faults in
 // the pages just ahead of where the process writes into new heap (MemoryReuse.cpp says how it
 // finds them), on the core that the single-threaded compile leaves idle; returnFreedMemory() stops
-// it. At 10⁶ masses that takes the compile from 2.0 to 1.7 s and the file → first step from 3.35
-// to 2.8 s for 1 % more peak memory (bench/README.md, "Freed memory reused").
+// it. At 10⁶ masses that takes the compile from 2.3 to 1.5 s and the file → first step from 3.6
+// to 2.6 s for 2.5 % more peak memory (bench/README.md, "Heap prefaulted").
 //
 // Only the time to fault pages changes; every result is the same to the bit.
 #pragma once
