@@ -37,6 +37,8 @@ namespace {
 // writer that fills memory at full speed (a table cleared by fill_n): with 8 MiB the compile's own
 // thread still zeroed huge pages itself (perf: clear_page_erms), at 64 MiB nothing more is gained;
 // the price is 26 MB of peak at 10⁶ masses (1.58 → 1.61 GB).
+// Until the heap has grown by 64 MiB nothing is populated: a small model's process touches a few
+// MB, and what it would gain is less than what a populated lead it never uses costs.
 class HeapPrefaulter {
  public:
   void start() {
@@ -61,6 +63,7 @@ class HeapPrefaulter {
  private:
   static constexpr uintptr_t kWindow = uintptr_t{2} << 20;
   static constexpr size_t kLead = 16;  ///< windows populated after a touched one, at most (a sixteenth of the heap)
+  static constexpr uintptr_t kStartFrom = uintptr_t{64} << 20;  ///< heap grown by less: nothing populated
   static constexpr uintptr_t kPadFrom = uintptr_t{256} << 20;
   static constexpr uintptr_t kTopPad = uintptr_t{64} << 20;
 
@@ -102,7 +105,7 @@ class HeapPrefaulter {
   std::optional<bool> populateTouchedWindows(uintptr_t base) {
     const uintptr_t page = static_cast<uintptr_t>(sysconf(_SC_PAGESIZE));
     uintptr_t top = heapTop() & ~(page - 1);
-    if (top <= base) return false;
+    if (top <= base || top - base < kStartFrom) return false;  // a small model: nothing worth a thread's work
     done_.resize((top - base + kWindow - 1) / kWindow, 0);
     // A large heap grows by large blocks (the symbolic arena's chunks, tables, vectors): let the
     // heap's top run ahead of them, so that the lead covers the next block before it is allocated.
