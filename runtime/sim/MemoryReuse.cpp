@@ -3,6 +3,7 @@
 #include "sim/MemoryReuse.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -59,6 +60,7 @@ class HeapPrefaulter {
     thread_.join();
   }
   ~HeapPrefaulter() { stop(); }
+  size_t populatedBytes() const { return populatedBytes_.load(std::memory_order_relaxed); }
 
  private:
   static constexpr uintptr_t kWindow = uintptr_t{2} << 20;
@@ -124,6 +126,7 @@ class HeapPrefaulter {
       size_t last = std::min(done_.size(), w + 1 + lead);
       uintptr_t end = std::min(top, base + last * kWindow);
       if (madvise(reinterpret_cast<void*>(begin), end - begin, MADV_POPULATE_WRITE) != 0) return std::nullopt;
+      populatedBytes_.fetch_add(end - begin, std::memory_order_relaxed);
       std::fill(done_.begin() + static_cast<long>(w), done_.begin() + static_cast<long>(last), 1);
       w = last - 1;
       populated = true;
@@ -131,6 +134,7 @@ class HeapPrefaulter {
     return populated;
   }
 
+  std::atomic<size_t> populatedBytes_{0};
   bool topPadded_ = false;
   std::vector<char> done_;                ///< per window: populated here, or found touched
   std::vector<unsigned char> resident_;  ///< mincore's answer, per page from the first window not done
@@ -157,6 +161,14 @@ void startHeapPrefault() {
 void stopHeapPrefault() {
 #ifdef QDOT_HEAP_PREFAULT
   prefaulter().stop();
+#endif
+}
+
+size_t heapPrefaultedBytes() {
+#ifdef QDOT_HEAP_PREFAULT
+  return prefaulter().populatedBytes();
+#else
+  return 0;
 #endif
 }
 

@@ -24,6 +24,7 @@
 #pragma once
 
 #include <climits>
+#include <cstddef>
 #include <cstdlib>
 #include <string_view>
 
@@ -37,6 +38,8 @@ namespace qdot::rt {
 void startHeapPrefault();
 /// Stops it (waits for its thread); not started: no effect.
 void stopHeapPrefault();
+/// The bytes of heap it has populated so far (windows ahead of the writer; `--stats` shows them).
+size_t heapPrefaultedBytes();
 
 /// Blocks of any size from the heap, and no trimming of freed pages until returnFreedMemory().
 /// Call once, before the process allocates much. (Where glibc cannot map more heap it still maps

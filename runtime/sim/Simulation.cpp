@@ -303,6 +303,7 @@ SimulationResult simulateWith(const QdotModel& model, const SimulationSettings& 
     if (solving && session->firstStepDone())
       result.firstStepSeconds = std::chrono::duration<double>(*session->firstStepDone() - clock).count();
   result.peakMemoryBytes = peakResidentBytes();
+  result.prefaultedBytes = heapPrefaultedBytes();
   try {
     sink.finish();
   } catch (const std::exception& e) {

@@ -93,6 +93,7 @@ struct SimulationResult {
   /// The process's peak resident memory when the run ended (compiling included, for `qdot run`),
   /// in bytes; 0 where the system does not say.
   size_t peakMemoryBytes = 0;
+  size_t prefaultedBytes = 0;  ///< heap populated ahead of use by the prefaulter (sim/MemoryReuse.h)
 };
 
 /// Runs the model over the grid, writing into sink (begin, rows, finish). Never throws for

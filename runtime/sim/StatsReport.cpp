@@ -66,7 +66,11 @@ std::string formatStats(const SimulationResult& r) {
        fmt::format("setup {:.3f} s, solve {:.3f} s (first step {:.3f} s)", r.setupSeconds, r.solveSeconds,
                    r.firstStepSeconds));
   if (r.peakMemoryBytes)  // a large model's memory is a figure users compare, as its time
-    line(out, "peak memory", fmt::format("{:.1f} MiB resident (the whole process so far)", r.peakMemoryBytes / 1048576.0));
+    line(out, "peak memory",
+         fmt::format("{:.1f} MiB resident (the whole process so far){}", r.peakMemoryBytes / 1048576.0,
+                     r.prefaultedBytes ? fmt::format("; {:.0f} MiB of heap populated ahead of use by another thread",
+                                                     r.prefaultedBytes / 1048576.0)
+                                       : ""));
   return out;
 }
 

@@ -14,6 +14,11 @@ TEST(StatsReport, PeakMemoryIsReportedInMebibytesWhenKnown) {
   SimulationResult r;
   r.peakMemoryBytes = 3 * 1048576 + 104858;  // 3.1 MiB
   EXPECT_NE(formatStats(r).find("  peak memory            3.1 MiB resident"), std::string::npos) << formatStats(r);
+  EXPECT_EQ(formatStats(r).find("ahead of use"), std::string::npos) << "nothing prefaulted: not mentioned";
+  r.prefaultedBytes = 96 * 1048576;
+  EXPECT_NE(formatStats(r).find("3.1 MiB resident (the whole process so far); 96 MiB of heap populated ahead of use"),
+            std::string::npos)
+      << formatStats(r);
   r.peakMemoryBytes = 0;
   EXPECT_EQ(formatStats(r).find("peak memory"), std::string::npos);
 }
