@@ -34,10 +34,11 @@ namespace {
 // this thread instead. Windows nobody touches (capacity reserved and never used: 0.7 GB of the 10⁶
 // chain's heap) stay unpopulated, so the resident memory stays what the process uses plus at most
 // kLead windows per block being written. Populating everything the heap grows by instead raised the
-// 10⁶ chain's peak from 1.58 to 2.29 GB. The lead is 32 MiB so that the prefaulter stays ahead of a
-// writer that fills memory at full speed (a table cleared by fill_n): with 8 MiB the compile's own
-// thread still zeroed huge pages itself (perf: clear_page_erms), at 64 MiB nothing more is gained;
-// the price is 26 MB of peak at 10⁶ masses (1.58 → 1.61 GB).
+// 10⁶ chain's peak from 1.58 to 2.29 GB. The lead is a sixteenth of the heap, at most 32 MiB, so
+// that the prefaulter stays ahead of a writer that fills memory at full speed (a table cleared by
+// fill_n): with 8 MiB the compile's own thread still zeroed huge pages itself (perf:
+// clear_page_erms), at 64 MiB nothing more is gained; the price is 26 MB of peak at 10⁶ masses
+// (1.58 → 1.61 GB).
 // Until the heap has grown by 64 MiB nothing is populated: a small model's process touches a few
 // MB, and what it would gain is less than what a populated lead it never uses costs.
 class HeapPrefaulter {
@@ -96,7 +97,7 @@ class HeapPrefaulter {
       // Idle (a small model, or the solver running in memory already there): look less often.
       pause = populated ? std::chrono::microseconds(250) : std::min(2 * pause, std::chrono::microseconds(2000));
       lock.lock();
-      wake_.wait_for(lock, pause, [this] { return stop_; });
+      wake_.wait_for(lock, pause, [this] { return stop_.load(); });
     }
   }
 
@@ -141,7 +142,7 @@ class HeapPrefaulter {
   std::thread thread_;
   std::mutex mutex_;
   std::condition_variable wake_;
-  bool stop_ = false;
+  std::atomic<bool> stop_ = false;  ///< set under mutex_ (for the wait), read without it while populating
 };
 
 HeapPrefaulter& prefaulter() {
