@@ -161,16 +161,23 @@ void Context::clear() {
   one_ = constant(1.0);
 }
 
+// The key a number is interned under (normalized: -0 and NaN payloads are one node each).
+namespace {
+Node constantKey(double v) {
+  Node n{};
+  n.kind = Kind::Constant;
+  n.value = normalizeNumber(v);
+  return n;
+}
+}  // namespace
+
 // Numbers recur constantly (0, 1, 2, -1, 0.5, model parameters): a direct-mapped cache in front
 // of the intern table answers most of them without hashing the node.
 Expr Context::constant(double v) {
-  v = normalizeNumber(v);
-  uint64_t bits = numberBits(v);
+  Node n = constantKey(v);
+  uint64_t bits = numberBits(n.value);
   auto& slot = impl_->recentConstants[(bits * 0x9E3779B97F4A7C15ull) >> (64 - Impl::kConstantCacheBits)];
   if (slot.node && slot.bits == bits) return slot.node;
-  Node n{};
-  n.kind = Kind::Constant;
-  n.value = v;
   slot = {bits, impl_->intern(n)};
   return slot.node;
 }
@@ -180,9 +187,7 @@ std::vector<Expr> Context::constants(std::span<const double> values) {
   impl_->reserve(0, values.size());  // the table does not move while it is read ahead
   std::vector<uint64_t> hashes(values.size());
   for (size_t i = 0; i < values.size(); ++i) {
-    Node key{};
-    key.kind = Kind::Constant;
-    key.value = normalizeNumber(values[i]);
+    Node key = constantKey(values[i]);
     computeDerived(key);
     hashes[i] = key.hash;
   }
@@ -191,9 +196,7 @@ std::vector<Expr> Context::constants(std::span<const double> values) {
   size_t mask = impl_->tableSize - 1;
   for (size_t i = 0; i < values.size(); ++i) {
     if (i + kAhead < values.size()) __builtin_prefetch(&impl_->table[hashes[i + kAhead] & mask]);
-    Node key{};
-    key.kind = Kind::Constant;
-    key.value = values[i];
+    Node key = constantKey(values[i]);
     out.push_back(impl_->intern(key));
   }
   return out;
