@@ -197,7 +197,7 @@ ExitCode buildExecutable(Compilation& c, const ExecutableOptions& options, std::
   if (!continueTo(c, Stage::Bytecode)) return ExitCode::ModelError;
   if (size_t longest = longestList(*c.bytecode); longest > bc::runs::kMaxValues) {
     log << "qdot: error: the model is too large for an executable: one of its tables (the Jacobian's "
-        << c.bytecode->description.jacobianNonzeros() << " nonzeros, or a program's code) has " << longest
+        << c.bytecode->description->jacobianNonzeros() << " nonzeros, or a program's code) has " << longest
         << " entries, more than the " << bc::runs::kMaxValues << " the embedded form holds; run it with qdot run\n";
     return ExitCode::ModelError;
   }

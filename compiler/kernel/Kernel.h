@@ -72,7 +72,7 @@ struct Source {
 
 /// Everything a backend needs to implement the model ABI.
 struct KernelModule {
-  ModelDescription description;  ///< names, flags, Jacobian pattern (carried on by every backend)
+  SharedDescription description;  ///< names, flags, Jacobian pattern (shared by every backend)
   /// parameters: out[i] = p_i. initialValues: out = [y0 (n), yp0 (n), nominal (n)].
   /// residual: out = F (n). jacobian: out = values in CSC order. outputs, invariants: one each.
   PerProgram<Program> programs;
@@ -81,7 +81,7 @@ struct KernelModule {
 
   Program& program(ModelProgram p) { return programs[programIndex(p)]; }
   const Program& program(ModelProgram p) const { return programs[programIndex(p)]; }
-  size_t variableCount() const { return description.variableCount(); }
+  size_t variableCount() const { return description->variableCount(); }
 };
 
 /// Builds every program of the model. `ctx` must be the Context the Dae's expressions live in

@@ -74,7 +74,7 @@ class Builder {
   }
 
   void describeModel() {
-    ModelDescription& d = m_.description;
+    ModelDescription& d = m_.description.edit();
     d.name = dae_.name;
     d.variableNames.reserve(dae_.variables.size());
     d.isDifferential.reserve(dae_.variables.size());
@@ -279,7 +279,7 @@ class Builder {
       size_t j = u->variable;
       if (!acceptInitialEquation(e, i, j, true)) return true;  // reported
       uint32_t src = addSource("initial equation " + std::to_string(i + 1), e.origin.range, equationText(e));
-      starts.values[j] = value, starts.sources[j] = src, m_.description.fixed[j] = kFixedAsWritten;
+      starts.values[j] = value, starts.sources[j] = src, m_.description.edit().fixed[j] = kFixedAsWritten;
       startUse_[j] = dae::StartUse::Required;
       return true;
     }
@@ -320,7 +320,7 @@ class Builder {
       const dae::Declaration& d = dae_.variables[j].declaration;
       starts.values.push_back(d.start);
       startUse_.push_back(d.fixedGiven ? (d.fixed ? dae::StartUse::Required : dae::StartUse::Guess)  // as written
-                          : m_.description.fixed[j] ? dae::StartUse::Default
+                          : m_.description->fixed[j] ? dae::StartUse::Default
                                                     : dae::StartUse::Guess);
     }
     starts.sources.assign(n, UINT32_MAX);
@@ -342,7 +342,7 @@ class Builder {
     std::optional<std::vector<char>> kept = dae::planInitialization(dae_, initialRows_, startUse_, ctx_, diags_);
     if (!kept) return;
     for (size_t j = 0; j < kept->size(); ++j)
-      if (!(*kept)[j]) m_.description.fixed[j] = kStartGuess;
+      if (!(*kept)[j]) m_.description.edit().fixed[j] = kStartGuess;
   }
 
   // out = [y0 (n), yp0 (n), nominal (n)]; stores of a plain 0 serve no source. Runs of numbers
@@ -440,16 +440,16 @@ class Builder {
     JacobianEntries jac = initialRows_.empty() ? differentiate(dae_, unknowns(), ctx_, cj)
                                                 : differentiate(withInitialRows(), unknowns(), ctx_, cj);
     auto nonzeros = static_cast<uint32_t>(jac.rowIndices.size());
-    m_.description.jacobianColumnStarts = std::move(jac.columnStarts);
-    m_.description.jacobianRowIndices = std::move(jac.rowIndices);
+    m_.description.edit().jacobianColumnStarts = std::move(jac.columnStarts);
+    m_.description.edit().jacobianRowIndices = std::move(jac.rowIndices);
     std::vector<Expr> roots;
     std::vector<uint32_t> rows;  // the rows the roots are (template ones are not)
     for (uint32_t i : scalarRows_) roots.push_back(dae_.equations[i].residual), rows.push_back(i);
     for (size_t k = 0; k < initialRows_.size(); ++k) {  // after every DAE row: rows used only at t0
       const auto& e = initialRows_[k];
       auto row = static_cast<int32_t>(dae_.equations.size() + k);
-      m_.description.initialRows.push_back(row);
-      m_.description.initialRowLabels.push_back("initial equation " + equationText(e));
+      m_.description.edit().initialRows.push_back(row);
+      m_.description.edit().initialRowLabels.push_back("initial equation " + equationText(e));
       equationSource_.push_back(addSource("initial equation (t0 only)", e.origin.range, equationText(e)));
       roots.push_back(e.residual), rows.push_back(static_cast<uint32_t>(row));
     }

@@ -18,10 +18,10 @@ std::string join(const std::vector<std::string>& names) {
 const std::vector<std::string>* namesOfLoad(Op op, const KernelModule& m) {
   switch (op) {
     case Op::LoadY:
-    case Op::LoadYp: return &m.description.variableNames;
+    case Op::LoadYp: return &m.description->variableNames;
     case Op::LoadP:
     case Op::LoadGiven:
-    case Op::LoadOverridden: return &m.description.parameterNames;
+    case Op::LoadOverridden: return &m.description->parameterNames;
     default: return nullptr;
   }
 }

@@ -326,7 +326,7 @@ void lowerParts(const kernel::Program& p, const ProgramSplit& split, uint32_t fi
 LoweredModule lowerKernels(const kernel::KernelModule& k, llvm::LLVMContext& ctx, uint32_t maxInstructions,
                            uint32_t programs) {
   LoweredModule out;
-  out.module = std::make_unique<llvm::Module>("qdot." + k.description.name, ctx);
+  out.module = std::make_unique<llvm::Module>("qdot." + k.description->name, ctx);
   for (size_t i = 0; i < kModelProgramCount; ++i) {
     if (!(programs & (1u << i))) continue;
     ModelProgram id = programAt(i);

@@ -56,14 +56,14 @@ struct JitModel : AdaptedModel {
 // write out of bounds).
 Status validate(const kernel::KernelModule& k) {
   for (size_t i = 0; i < kModelProgramCount; ++i) {
-    size_t expected = k.description.outputCount(programAt(i));
+    size_t expected = k.description->outputCount(programAt(i));
     if (k.programs[i].outputCount != expected)
       return Error{"kernel program " + k.programs[i].name + " writes " + std::to_string(k.programs[i].outputCount) +
                    " values, the model ABI expects " + std::to_string(expected)};
-    std::string e = kernel::checkLoops(k.programs[i], k.variableCount(), k.description.parameterCount());
+    std::string e = kernel::checkLoops(k.programs[i], k.variableCount(), k.description->parameterCount());
     if (!e.empty()) return Error{"kernel program " + k.programs[i].name + ": " + e};
   }
-  if (std::string e = k.description.inconsistency(); !e.empty()) return Error{"kernel module: " + e};
+  if (std::string e = k.description->inconsistency(); !e.empty()) return Error{"kernel module: " + e};
   return {};
 }
 

@@ -31,7 +31,7 @@ struct NativeModel : AdaptedModel {
     ModelCall call = c;
     call.indexTable = module->functions[i].indexTable.data();  // the native code reads it through the call
     programs[i](&call, out, spill[i].data());
-    size_t count = module->description.outputCount(program);
+    size_t count = module->description->outputCount(program);
     if (std::all_of(out, out + count, [](double x) { return std::isfinite(x); })) return 0;
     std::vector<double> scratch(count);  // the VM fails the same way and says where
     error = callProgram(*vm, program, c, scratch.data()) != 0 ? vm->lastError(vm.get()) : "a value is not finite";

@@ -147,7 +147,7 @@ int main(int argc, char** argv) {
   rt::addRunOptions(app, options);
   // The module the model already read (not a second copy: a large model's is most of the process).
   const bc::Module& module = native ? exe::moduleOf(*model) : vm::moduleOf(*model);
-  const std::vector<std::string>& fixed = module.description.structuralParameters;
+  const std::vector<std::string>& fixed = module.description->structuralParameters;
   app.footer([&] {  // made for --help only; CLI11 adds a newline after it
     std::string help = parameterHelp(*model) + structuralHelp(fixed);
     if (help.ends_with('\n')) help.pop_back();

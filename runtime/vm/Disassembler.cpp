@@ -15,9 +15,9 @@ std::string reg(uint32_t r) { return std::string("r").append(std::to_string(r));
 
 std::string indexName(const bc::Module& m, bc::Opcode op, uint32_t i, const bc::Function& f) {
   const std::vector<std::string>* names = nullptr;
-  if (op == bc::Opcode::LoadY || op == bc::Opcode::LoadYp) names = &m.description.variableNames;
+  if (op == bc::Opcode::LoadY || op == bc::Opcode::LoadYp) names = &m.description->variableNames;
   if (op == bc::Opcode::LoadP || op == bc::Opcode::LoadGiven || op == bc::Opcode::LoadOverridden)
-    names = &m.description.parameterNames;
+    names = &m.description->parameterNames;
   if (op == bc::Opcode::LoadConst && i < f.constants.size()) return std::to_string(i) + std::string(" (").append(shortestText(f.constants[i])) + ")";
   if (op == bc::Opcode::LoadYLooped || op == bc::Opcode::LoadYpLooped || op == bc::Opcode::LoadPLooped)
     return std::to_string(i) + " + L";

@@ -184,7 +184,7 @@ Result<Module> deserialize(std::span<const uint8_t> bytes) {
   if (uint32_t version = r.u32(); version != kFormatVersion)
     return Error{"bytecode format version " + std::to_string(version) + ", expected " + std::to_string(kFormatVersion)};
   Module m;
-  m.description = readDescription(r);
+  m.description = SharedDescription(readDescription(r));
   for (Function& f : m.functions) f = readFunction(r);
   std::vector<std::string> labels = r.strings(), wheres = r.strings(), texts = r.strings();
   if (wheres.size() != labels.size() || texts.size() != labels.size()) return Error{"malformed bytecode module (locations)"};

@@ -196,7 +196,7 @@ class FunctionChecker {
 };
 
 std::string checkModule(const Module& m) {
-  if (std::string e = m.description.inconsistency(); !e.empty()) return e;
+  if (std::string e = m.description->inconsistency(); !e.empty()) return e;
   for (size_t f = 0; f < kModelProgramCount; ++f) {
     std::string e = FunctionChecker(m, programAt(f)).check();
     if (!e.empty()) return std::string("function ") + kModelProgramNames[f] + ": " + e;

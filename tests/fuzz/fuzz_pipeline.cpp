@@ -38,11 +38,11 @@ void checkDiagnostics(const driver::Compilation& c) {
 // Instruction i defines register %i and reads only earlier registers; each program writes what the
 // description says it writes and keeps the loop rules.
 void checkKernels(const kernel::KernelModule& m, size_t unknowns) {
-  check(m.variableCount() == unknowns && m.description.inconsistency().empty());
+  check(m.variableCount() == unknowns && m.description->inconsistency().empty());
   for (size_t p = 0; p < kModelProgramCount; ++p) {
     const kernel::Program& program = m.programs[p];
-    check(program.outputCount == m.description.outputCount(programAt(p)));
-    check(kernel::checkLoops(program, m.variableCount(), m.description.parameterCount()).empty());
+    check(program.outputCount == m.description->outputCount(programAt(p)));
+    check(kernel::checkLoops(program, m.variableCount(), m.description->parameterCount()).empty());
     for (uint32_t i = 0; i < program.code.size(); ++i) {
       const kernel::Instr& ins = program.code[i];
       uint32_t reads = kernel::readCount(ins.op);

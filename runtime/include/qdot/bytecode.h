@@ -172,7 +172,7 @@ inline constexpr uint32_t kFormatVersion = 7;
 
 /// A whole model: its description (names, flags, Jacobian pattern) and one function per program.
 struct Module {
-  ModelDescription description;
+  SharedDescription description;  ///< shared with the kernels it was emitted from
   PerProgram<Function> functions;
   std::vector<Location> locations;
 

@@ -36,7 +36,9 @@ struct AdaptedModel : QdotModel {
   const int32_t* fixedFlags = nullptr;       ///< [nVariables], owned by the backend's description
   std::vector<double> noneGiven;             ///< used when the runtime passes no given values
   std::vector<uint8_t> noneOverridden;
-  mutable std::vector<double> startScratch;  ///< [y0 | yp0 | nominal]
+  /// [y0 | yp0 | nominal], sized by the first initialValues call: a second tier (the background
+  /// JIT) never makes one, and at 10⁶ unknowns it would be 48 MB written for nothing.
+  mutable std::vector<double> startScratch;
   mutable std::string error;                 ///< lastError
 };
 
@@ -51,7 +53,6 @@ struct ModelAdapter {
     m.fixedFlags = description.fixed.data();
     m.noneGiven.assign(m.nParameters, 0.0);
     m.noneOverridden.assign(m.nParameters, 0);
-    m.startScratch.assign(3 * size_t{m.nVariables}, 0.0);
     m.parameters = parameters, m.initialValues = initialValues, m.fixedStarts = fixedStarts;
     m.residual = residual, m.jacobian = jacobian, m.outputs = outputs, m.invariants = invariants;
     m.lastError = lastError, m.destroy = destroy;
@@ -78,6 +79,7 @@ struct ModelAdapter {
     const Model& m = self(s);
     ModelCall c;
     c.t = t0, c.p = p;
+    m.startScratch.resize(3 * size_t{m.nVariables});
     int rc = m.run(ModelProgram::InitialValues, c, m.startScratch.data());
     const double* v = m.startScratch.data();
     size_t n = m.nVariables;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -110,6 +111,31 @@ struct ModelDescription {
         return "a derivative link is out of range";
     return "";
   }
+};
+
+/// The one ModelDescription of a compiled model, shared by what carries it: the kernels, the bytecode
+/// module made from them, and the models built from either. A model of 10⁶ masses has about 140 MB
+/// of names, flags and pattern; the tiered run keeps the kernels (for the background JIT) and the
+/// VM's module alive together, and with copies it held two. Copying shares; edit() copies first if
+/// the description is shared (so a copy edited, as tests do, never changes another's), and is for
+/// whoever builds a module, before it is handed on: not thread-safe against concurrent copies.
+class SharedDescription {
+ public:
+  SharedDescription() : d_(std::make_shared<ModelDescription>()) {}
+  explicit SharedDescription(ModelDescription d) : d_(std::make_shared<ModelDescription>(std::move(d))) {}
+  const ModelDescription& operator*() const { return *d_; }
+  const ModelDescription* operator->() const { return d_.get(); }
+  operator const ModelDescription&() const { return *d_; }  // NOLINT: reads as the description itself
+  /// The description to change: this holder's own (copied first if another holder shares it).
+  ModelDescription& edit() {
+    if (d_.use_count() > 1) d_ = std::make_shared<ModelDescription>(*d_);
+    return *d_;
+  }
+  /// Whether two holders share one description (tests; what the tiered run relies on).
+  bool sharesWith(const SharedDescription& other) const { return d_ == other.d_; }
+
+ private:
+  std::shared_ptr<ModelDescription> d_;
 };
 
 }  // namespace qdot

@@ -53,8 +53,8 @@ function residual: 2 outputs, 12 instructions, 0 constants
 TEST(Kernel, TinyJacobianIsExactAndSharesCse) {
   TinyDae d;
   kernel::KernelModule m = kernel::buildKernels(d.dae, d.ctx, d.diags);
-  EXPECT_EQ(m.description.jacobianColumnStarts, (std::vector<int32_t>{0, 2, 4}));
-  EXPECT_EQ(m.description.jacobianRowIndices, (std::vector<int32_t>{0, 1, 0, 1}));
+  EXPECT_EQ(m.description->jacobianColumnStarts, (std::vector<int32_t>{0, 2, 4}));
+  EXPECT_EQ(m.description->jacobianRowIndices, (std::vector<int32_t>{0, 1, 0, 1}));
   EXPECT_EQ(m.sharedTemporaries, 1u);
   EXPECT_EQ(text(m, ModelProgram::Jacobian), R"(
 function jacobian: 4 outputs, 14 instructions, 1 constants
@@ -126,8 +126,8 @@ TEST(Kernel, StartValuesNominalsAndFixedFlags) {
   std::vector<double> p = {3.0, 1.5}, out(6);
   kernel::interpret(m.program(ModelProgram::InitialValues), {.p = p.data()}, out);
   EXPECT_EQ(out, (std::vector<double>{1.5, 0, 0, 0, 4, 0}));  // y0 = (k/2, 0), yp0 = 0, nominal = (4, 0)
-  EXPECT_EQ(m.description.fixed, (std::vector<int32_t>{1, 1}));
-  EXPECT_EQ(m.description.isDifferential, (std::vector<int32_t>{1, 1}));
+  EXPECT_EQ(m.description->fixed, (std::vector<int32_t>{1, 1}));
+  EXPECT_EQ(m.description->isDifferential, (std::vector<int32_t>{1, 1}));
 }
 
 // Initial equations: `v = expression` over parameters sets a start value (then fixed); any other
@@ -149,9 +149,9 @@ TEST(Kernel, ExplicitInitialEquationsSetStartsOthersBecomeRows) {
   std::vector<double> p = {3.0, 1.5}, out(6);
   kernel::interpret(m.program(ModelProgram::InitialValues), {.p = p.data()}, out);
   EXPECT_EQ(out, (std::vector<double>{1.5, 3.0, 0, 0, 0, 0}));
-  EXPECT_EQ(m.description.fixed, (std::vector<int32_t>{kStartGuess, kFixedAsWritten}));  // x from der(der(x)) = 5
-  EXPECT_EQ(m.description.initialRows, (std::vector<int32_t>{2}));
-  EXPECT_EQ(m.description.residualCount(), 3u);
+  EXPECT_EQ(m.description->fixed, (std::vector<int32_t>{kStartGuess, kFixedAsWritten}));  // x from der(der(x)) = 5
+  EXPECT_EQ(m.description->initialRows, (std::vector<int32_t>{2}));
+  EXPECT_EQ(m.description->residualCount(), 3u);
 }
 
 TEST(Kernel, OverDeterminedInitialConditionsAreNamed) {

@@ -70,7 +70,7 @@ TEST_P(JitExamplesTest, AgreesWithTheKernelInterpreter) {
   const QdotModel* q = m.model;
   size_t n = q->nVariables, np = q->nParameters;
   EXPECT_EQ(q->abiVersion, uint32_t(QDOT_MODEL_ABI_VERSION));
-  EXPECT_EQ(q->jacobianNonzeros, m.kernel.description.jacobianRowIndices.size());
+  EXPECT_EQ(q->jacobianNonzeros, m.kernel.description->jacobianRowIndices.size());
 
   // Parameters: defaults, then some overridden with random values.
   std::vector<double> p(np), given = randoms(np, 0.5, 2.0);

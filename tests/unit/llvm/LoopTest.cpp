@@ -43,7 +43,7 @@ struct Writer {
 // A model of n variables x0.. and one parameter k whose residual is `residual`.
 kernel::KernelModule moduleWith(kernel::Program residual, uint32_t n) {
   kernel::KernelModule m;
-  ModelDescription& d = m.description;
+  ModelDescription& d = m.description.edit();
   d.name = "Loops";
   for (uint32_t i = 0; i < n; ++i) d.variableNames.push_back(std::string("x").append(std::to_string(i)));
   d.isDifferential.assign(n, 1), d.fixed.assign(n, 0), d.jacobianColumnStarts.assign(n + 1, 0);
@@ -227,15 +227,15 @@ TEST(Loops, AParameterArrayReadInALoopOnEveryBackend) {
   w.endLoop();
   w.op(Op::Store, w.op(Op::Mul, k, w.op(Op::LoadY, 0, 0, 0, n - 1)), 0, 0, n - 1);
   kernel::KernelModule m = moduleWith(w.p, n);
-  m.description.parameterNames.clear();
+  m.description.edit().parameterNames.clear();
   kernel::Program& params = m.program(ModelProgram::Parameters);
   params.code.clear();
   for (uint32_t i = 0; i < n; ++i) {
-    m.description.parameterNames.push_back("a" + std::to_string(i));
+    m.description.edit().parameterNames.push_back("a" + std::to_string(i));
     params.code.push_back(Instr{Op::LoadGiven, 0, 0, 0, i});
     params.code.push_back(Instr{Op::Store, 2 * i, 0, 0, i});
   }
-  m.description.parameterDescriptions.assign(n, "");
+  m.description.edit().parameterDescriptions.assign(n, "");
   params.outputCount = n;
   ASSERT_EQ(kernel::checkLoops(m.program(ModelProgram::Residual), n, n), "");
   Inputs in(n);

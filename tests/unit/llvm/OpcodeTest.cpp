@@ -42,7 +42,7 @@ kernel::KernelModule opcodeModule() {
   res.outputCount = static_cast<uint32_t>(results.size());
 
   kernel::KernelModule m;
-  ModelDescription& d = m.description;
+  ModelDescription& d = m.description.edit();
   d.name = "Opcodes";
   size_t n = results.size();
   for (size_t i = 0; i < n; ++i) d.variableNames.push_back("v" + std::to_string(i));

@@ -57,8 +57,8 @@ size_t expectSameKernels(const std::string& text, size_t blocks, const test::Giv
   EXPECT_FALSE(scalar.c.dae->templated());
   EXPECT_EQ(looped.c.dae->templateBlocks.size(), blocks);
   const kernel::KernelModule &a = scalar.kernels(), &b = looped.kernels();
-  EXPECT_EQ(a.description.variableNames, b.description.variableNames);
-  EXPECT_EQ(a.description.fixed, b.description.fixed);
+  EXPECT_EQ(a.description->variableNames, b.description->variableNames);
+  EXPECT_EQ(a.description->fixed, b.description->fixed);
   std::vector<size_t> row = rowOfUnknown(scalar);
   auto ja = entries(a.description, row), jb = entries(b.description, {});
   EXPECT_EQ(ja.size(), jb.size());
@@ -98,7 +98,7 @@ TEST(ForEquations, RodIsOneLoopWithTheScalarResidualAndJacobian) {
   EXPECT_EQ(expectSameKernels(kRod, 1), 1u);
   // Rows in the order of the unknowns is the order the rod is written in: the same pattern.
   Compiled scalar(kRod, false), looped(kRod, true);
-  EXPECT_EQ(scalar.kernels().description.jacobianRowIndices, looped.kernels().description.jacobianRowIndices);
+  EXPECT_EQ(scalar.kernels().description->jacobianRowIndices, looped.kernels().description->jacobianRowIndices);
   const dae::TemplateBlock& block = looped.c.dae->templateBlocks[0];
   EXPECT_EQ(block.firstRow, 0);
   EXPECT_EQ(block.region, (flat::Box{{2, 8}}));
@@ -271,7 +271,7 @@ end Rod;)");
   test::KernelValues v = test::evaluateAt(looped.kernels(), 0);
   EXPECT_EQ(v.start[0], 2 * 1.7);
   EXPECT_EQ(v.start[3], 1.7 * 4);
-  EXPECT_EQ(looped.kernels().description.fixed[3], kFixedAsWritten);
+  EXPECT_EQ(looped.kernels().description->fixed[3], kFixedAsWritten);
 }
 
 TEST(ForEquations, AnInitialEquationOnADerivativeKeepsTheModelScalar) {

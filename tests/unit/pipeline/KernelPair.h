@@ -71,8 +71,8 @@ struct KernelValues {
 /// F, J and the invariants at trial state `trial` (y, y', cj and t fixed by it), with the default parameter values
 /// except those `given`.
 inline KernelValues evaluateAt(const kernel::KernelModule& k, int trial, const GivenParameters& givenValues = {}) {
-  size_t n = k.variableCount(), nnz = k.description.jacobianRowIndices.size();
-  const std::vector<std::string>& names = k.description.parameterNames;
+  size_t n = k.variableCount(), nnz = k.description->jacobianRowIndices.size();
+  const std::vector<std::string>& names = k.description->parameterNames;
   std::vector<double> p(names.size()), given(p.size(), 0.0);
   std::vector<uint8_t> overridden(p.size(), 0);
   for (const auto& [name, value] : givenValues) {
@@ -89,11 +89,11 @@ inline KernelValues evaluateAt(const kernel::KernelModule& k, int trial, const G
     yp[j] = 0.2 * std::cos(0.7 * j + 2 * trial);
   }
   ModelCall in{.t = 0.3, .cj = 17.0 + trial, .y = y.data(), .yp = yp.data(), .p = p.data()};
-  KernelValues v{std::vector<double>(n), std::vector<double>(nnz), std::vector<double>(k.description.invariantNames.size())};
+  KernelValues v{std::vector<double>(n), std::vector<double>(nnz), std::vector<double>(k.description->invariantNames.size())};
   kernel::interpret(k.program(ModelProgram::Residual), in, v.F);
   kernel::interpret(k.program(ModelProgram::Jacobian), in, v.J);
   kernel::interpret(k.program(ModelProgram::Invariants), in, v.invariants);
-  v.outputs.resize(k.description.outputNames.size());
+  v.outputs.resize(k.description->outputNames.size());
   kernel::interpret(k.program(ModelProgram::Outputs), in, v.outputs);
   v.start.resize(3 * n);
   kernel::interpret(k.program(ModelProgram::InitialValues), ModelCall{.t = 0.0, .p = p.data()}, v.start);

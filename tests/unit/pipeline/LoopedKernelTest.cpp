@@ -27,10 +27,10 @@ struct Compiled : test::CompiledKernels {
 size_t expectSameKernels(const std::string& text, const test::GivenParameters& given = {}) {
   Compiled scalar(text, false), looped(text, true);
   const kernel::KernelModule &a = scalar.kernels(), &b = looped.kernels();
-  EXPECT_EQ(a.description.variableNames, b.description.variableNames);
-  EXPECT_EQ(a.description.jacobianColumnStarts, b.description.jacobianColumnStarts);
-  EXPECT_EQ(a.description.jacobianRowIndices, b.description.jacobianRowIndices);
-  size_t n = a.variableCount(), nnz = a.description.jacobianRowIndices.size();
+  EXPECT_EQ(a.description->variableNames, b.description->variableNames);
+  EXPECT_EQ(a.description->jacobianColumnStarts, b.description->jacobianColumnStarts);
+  EXPECT_EQ(a.description->jacobianRowIndices, b.description->jacobianRowIndices);
+  size_t n = a.variableCount(), nnz = a.description->jacobianRowIndices.size();
   for (int trial = 0; trial < 3; ++trial) {
     test::KernelValues va = test::evaluateAt(a, trial, given), vb = test::evaluateAt(b, trial, given);
     for (size_t i = 0; i < n; ++i) EXPECT_NEAR(vb.F[i], va.F[i], 1e-13 * (1 + std::abs(va.F[i]))) << "F[" << i << "]";
@@ -45,9 +45,9 @@ size_t expectSameKernels(const std::string& text, const test::GivenParameters& g
 void expectSameInvariants(const std::string& text, size_t sums) {
   Compiled scalar(text, false), looped(text, true);
   const kernel::KernelModule &a = scalar.kernels(), &b = looped.kernels();
-  EXPECT_EQ(a.description.invariantNames, b.description.invariantNames);
-  ASSERT_FALSE(a.description.invariantNames.empty());
-  EXPECT_EQ(a.description.invariantNames.back(), "jacobi");
+  EXPECT_EQ(a.description->invariantNames, b.description->invariantNames);
+  ASSERT_FALSE(a.description->invariantNames.empty());
+  EXPECT_EQ(a.description->invariantNames.back(), "jacobi");
   for (int trial = 0; trial < 3; ++trial) {
     std::vector<double> va = test::evaluateAt(a, trial).invariants, vb = test::evaluateAt(b, trial).invariants;
     for (size_t i = 0; i < va.size(); ++i) EXPECT_NEAR(vb[i], va[i], 1e-13 * (1 + std::abs(va[i]))) << "invariant " << i;
@@ -123,7 +123,7 @@ end Chain;
   EXPECT_EQ(a.start, b.start);
   EXPECT_EQ(b.start[2], 0.1 * 3);
   EXPECT_EQ(b.start[17], 0.3);  // der(x[9])
-  EXPECT_EQ(scalar.kernels().description.fixed, looped.kernels().description.fixed);
+  EXPECT_EQ(scalar.kernels().description->fixed, looped.kernels().description->fixed);
   chain.replace(chain.find("der(x[n]) = v0"), 14, "der(x[n]) = x[1]");
   Compiled implicit(chain, true);
   ASSERT_TRUE(implicit.ok) << implicit.diagnostics();
@@ -254,10 +254,10 @@ TEST(LoopedKernels, ExplicitDefinitionsBecomeOutputsAndKeepTheLoops) {
   Compiled scalar(kChainWithDefinitions, false, true), looped(kChainWithDefinitions, true, true);
   const kernel::KernelModule &a = scalar.kernels(), &b = looped.kernels();
   EXPECT_EQ(loopCount(b.program(ModelProgram::Residual)), 2u);
-  EXPECT_EQ(a.description.variableNames, b.description.variableNames);
-  EXPECT_EQ(b.description.outputNames, (std::vector<std::string>{"tension", "push", "ends"}));
-  EXPECT_EQ(a.description.outputNames, b.description.outputNames);
-  EXPECT_EQ(a.description.jacobianRowIndices, b.description.jacobianRowIndices);
+  EXPECT_EQ(a.description->variableNames, b.description->variableNames);
+  EXPECT_EQ(b.description->outputNames, (std::vector<std::string>{"tension", "push", "ends"}));
+  EXPECT_EQ(a.description->outputNames, b.description->outputNames);
+  EXPECT_EQ(a.description->jacobianRowIndices, b.description->jacobianRowIndices);
   for (int trial = 0; trial < 3; ++trial) {
     test::KernelValues va = test::evaluateAt(a, trial), vb = test::evaluateAt(b, trial);
     for (size_t i = 0; i < va.F.size(); ++i) EXPECT_NEAR(vb.F[i], va.F[i], 1e-13 * (1 + std::abs(va.F[i]))) << "F[" << i << "]";
@@ -291,8 +291,8 @@ end Chain;
 )";
   Compiled scalar(text, false), looped(text, true);
   const kernel::KernelModule &a = scalar.kernels(), &b = looped.kernels();
-  EXPECT_EQ(a.description.outputNames, (std::vector<std::string>{"E", "P", "centre", "ramp", "weights"}));
-  EXPECT_EQ(b.description.outputNames, a.description.outputNames);
+  EXPECT_EQ(a.description->outputNames, (std::vector<std::string>{"E", "P", "centre", "ramp", "weights"}));
+  EXPECT_EQ(b.description->outputNames, a.description->outputNames);
   for (int trial = 0; trial < 3; ++trial) {
     std::vector<double> va = test::evaluateAt(a, trial).outputs, vb = test::evaluateAt(b, trial).outputs;
     ASSERT_EQ(va.size(), 5u);
@@ -333,7 +333,7 @@ TEST(LoopedKernels, EnergiesThroughDefinitionsAndFactorsKeepTheLoops) {
   EXPECT_EQ(expectSameKernels(kChainThroughDefinitions), 2u);  // the interior's rows, the kinematic rows
   Compiled scalar(kChainThroughDefinitions, false), looped(kChainThroughDefinitions, true);
   const kernel::KernelModule &a = scalar.kernels(), &b = looped.kernels();
-  EXPECT_EQ(b.description.outputNames, (std::vector<std::string>{"E", "P"}));
+  EXPECT_EQ(b.description->outputNames, (std::vector<std::string>{"E", "P"}));
   for (int trial = 0; trial < 3; ++trial) {
     std::vector<double> va = test::evaluateAt(a, trial).outputs, vb = test::evaluateAt(b, trial).outputs;
     for (size_t i = 0; i < va.size(); ++i) EXPECT_NEAR(vb[i], va[i], 1e-13 * (1 + std::abs(va[i]))) << "output " << i;
@@ -400,9 +400,9 @@ end ChainEq;
     Compiled scalar(text, false, true), looped(text, true, true);
     const kernel::KernelModule &a = scalar.kernels(), &b = looped.kernels();
     EXPECT_EQ(loopCount(b.program(ModelProgram::Residual)), 2u) << forceReadsE;
-    EXPECT_EQ(b.description.outputNames, (std::vector<std::string>{"E"}));
-    EXPECT_EQ(a.description.outputNames, b.description.outputNames);
-    EXPECT_EQ(a.description.variableNames, b.description.variableNames);
+    EXPECT_EQ(b.description->outputNames, (std::vector<std::string>{"E"}));
+    EXPECT_EQ(a.description->outputNames, b.description->outputNames);
+    EXPECT_EQ(a.description->variableNames, b.description->variableNames);
     EXPECT_EQ(loopCount(b.program(ModelProgram::Outputs)), 2u);
     for (int trial = 0; trial < 3; ++trial) {
       test::KernelValues va = test::evaluateAt(a, trial), vb = test::evaluateAt(b, trial);
@@ -615,7 +615,7 @@ TEST(LoopedKernels, NonUniformChainReadsItsParameterArraysInTheLoop) {
   const kernel::KernelModule& k = looped.kernels();
   EXPECT_EQ(loopedParameterLoads(k.program(ModelProgram::Residual)), 3u);  // m[%1], k[%1], k[%1+1]
   EXPECT_GE(loopedParameterLoads(k.program(ModelProgram::Jacobian)), 2u);  // m[%1] (cj·m), k[%1] + k[%1+1]
-  EXPECT_EQ(k.description.parameterNames.size(), 21u);  // ldpl reads the p vector qdot run fills
+  EXPECT_EQ(k.description->parameterNames.size(), 21u);  // ldpl reads the p vector qdot run fills
 }
 
 // Values given at run time to an element (`-p m[3]=…`) and to a parameter the arrays' bindings use

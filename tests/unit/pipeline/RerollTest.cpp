@@ -61,8 +61,8 @@ Evaluated evaluated(const dae::Dae& d, const kernel::KernelModule& k, int trial,
   Evaluated out;
   out.outputs = v.outputs;
   for (size_t r = 0; r < d.equations.size(); ++r) out.F[rowKey(d.equations[r])] = v.F[r];
-  const auto& starts = k.description.jacobianColumnStarts;
-  const auto& rows = k.description.jacobianRowIndices;
+  const auto& starts = k.description->jacobianColumnStarts;
+  const auto& rows = k.description->jacobianRowIndices;
   for (size_t col = 0; col + 1 < starts.size(); ++col)
     for (int32_t at = starts[col]; at < starts[col + 1]; ++at)
       out.J[{rowKey(d.equations[rows[at]]), static_cast<int>(col)}] = v.J[at];
@@ -99,7 +99,7 @@ void expectSameUpToRowOrder(const kernel::KernelModule& a, const kernel::KernelM
   };
   expectSameOutputs(x.outputs, y.outputs);
   near(sorted(x.F), sorted(y.F));
-  const auto &sa = a.description.jacobianColumnStarts, &sb = b.description.jacobianColumnStarts;
+  const auto &sa = a.description->jacobianColumnStarts, &sb = b.description->jacobianColumnStarts;
   ASSERT_EQ(sa, sb) << "the same number of entries in each column";
   for (size_t col = 0; col + 1 < sa.size(); ++col)
     near(sorted({x.J.begin() + sa[col], x.J.begin() + sa[col + 1]}), sorted({y.J.begin() + sb[col], y.J.begin() + sb[col + 1]}));
@@ -134,9 +134,9 @@ TEST(RerollRows, AChainOfComponentArraysLoopsWithTheScalarKernelsValues) {
   EXPECT_EQ(test::loopCount(a.program(ModelProgram::Residual)), 0u);
   EXPECT_EQ(test::loopCount(b.program(ModelProgram::Residual)), 2u);
   EXPECT_EQ(test::loopCount(b.program(ModelProgram::Outputs)), 4u);
-  EXPECT_EQ(a.description.outputNames, b.description.outputNames) << "the same columns, in the same order";
+  EXPECT_EQ(a.description->outputNames, b.description->outputNames) << "the same columns, in the same order";
   EXPECT_LT(b.program(ModelProgram::Residual).code.size(), a.program(ModelProgram::Residual).code.size() / 5);
-  EXPECT_EQ(a.description.parameterNames.size(), b.description.parameterNames.size());
+  EXPECT_EQ(a.description->parameterNames.size(), b.description->parameterNames.size());
   for (int trial = 0; trial < 3; ++trial) expectSame(evaluated(scalar, a, trial), evaluated(rerolled, b, trial));
   // The links' parameters were interleaved (k, c, s0 of each link) and are now one array each;
   // values given by name still reach the same parameters.

@@ -42,7 +42,7 @@ class Assembler {
 inline bc::Module tinyModule() {
   using bc::Opcode;
   bc::Module m;
-  ModelDescription& d = m.description;
+  ModelDescription& d = m.description.edit();
   d.name = "Tiny";
   d.variableNames = {"x"}, d.parameterNames = {"a"}, d.parameterDescriptions = {"a parameter"};
   d.isDifferential = {1}, d.fixed = {1};

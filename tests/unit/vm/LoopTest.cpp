@@ -22,7 +22,7 @@ using bc::Opcode;
 // A model of n variables x0..x{n-1} and one parameter k whose residual the test writes.
 bc::Module loopModule(uint32_t n) {
   bc::Module m = tinyModule();
-  ModelDescription& d = m.description;
+  ModelDescription& d = m.description.edit();
   d.variableNames.clear();
   for (uint32_t i = 0; i < n; ++i) d.variableNames.push_back("x" + std::to_string(i));
   d.isDifferential.assign(n, 1), d.fixed.assign(n, 0);
@@ -279,9 +279,10 @@ TEST(VmLoopValidation, RejectsAnStxSlotOutsideTheOutputs) {
 // parameters a0 .. a{n-1} (each its given value).
 bc::Module parameterLoop(uint32_t n) {
   bc::Module m = loopModule(n);
-  m.description.parameterNames.clear(), m.description.parameterDescriptions.clear();
-  for (uint32_t i = 0; i < n; ++i) m.description.parameterNames.push_back("a" + std::to_string(i));
-  m.description.parameterDescriptions.assign(n, "");
+  ModelDescription& d = m.description.edit();
+  d.parameterNames.clear(), d.parameterDescriptions.clear();
+  for (uint32_t i = 0; i < n; ++i) d.parameterNames.push_back("a" + std::to_string(i));
+  d.parameterDescriptions.assign(n, "");
   Assembler pa(m.function(ModelProgram::Parameters), {}, 1);
   for (uint32_t i = 0; i < n; ++i) pa.op(Opcode::LoadGiven, {pa.r(0), i}).op(Opcode::Store, {i, pa.r(0)});
   pa.ret(n);

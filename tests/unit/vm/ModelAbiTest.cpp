@@ -163,8 +163,8 @@ TEST(Validation, RejectsWhatTheInterpreterTrusts) {
               a.op(Opcode::LoadY, {0, 0}).op(Opcode::Store, {0, 0}).ret(1);  // writes the constant register
             }).find("operand out of range in ldy"),
             std::string::npos);
-  EXPECT_NE(invalid([](bc::Module& m) { m.description.jacobianRowIndices = {3}; }).find("Jacobian"), std::string::npos);
-  EXPECT_NE(invalid([](bc::Module& m) { m.description.fixed.clear(); }).find("per-variable"), std::string::npos);
+  EXPECT_NE(invalid([](bc::Module& m) { m.description.edit().jacobianRowIndices = {3}; }).find("Jacobian"), std::string::npos);
+  EXPECT_NE(invalid([](bc::Module& m) { m.description.edit().fixed.clear(); }).find("per-variable"), std::string::npos);
   bc::Module broken = tinyModule();
   broken.function(ModelProgram::Jacobian).code.clear();
   Result<ModelPtr> model = vm::createModel(broken);
