@@ -23,6 +23,10 @@ Then the time to the first step with glibc's defaults (QDOT_REUSE_FREED_MEMORY=0
 that the compiler frees reused by the solver (QDOT_PREFAULT_HEAP=0), and as qdot runs by default
 (reused, and the heap prefaulted by a second thread), side by side (--reuse-sizes).
 
+Then peak memory and the time to the first step in each backend mode (the default, VM first with
+the JIT in the background; --backend bytecode; --jit-wait) next to the hand-written program's peak
+(--mode-sizes): the 2x memory target holds in every mode.
+
 Then the whole process at issue 15's setting (rtol 1e-6, 1 s, KLU, columns x[1] and x[n]) for
 n = 10^3 ... 10^5 (--whole-sizes): `qdot run` in its default mode (tiering) against the hand-written
 program, wall time and peak memory, best of --repeat runs (one fresh process each).
@@ -63,9 +67,9 @@ def number(pattern, text, default=float("nan")):
     return float(m.group(1)) if m else default
 
 
-def measure(build, n, stop, env=None):
+def measure(build, n, stop, env=None, mode=("--jit-wait",)):
     qdot = [f"{build}/qdot", "run", CHAIN, "-p", f"n={n}", "--stop", str(stop), "--interval", str(stop),
-            "--outputs", "x[1]", "-o", "/dev/null", "--stats", "--jit-wait", "--no-progress"]
+            "--outputs", "x[1]", "-o", "/dev/null", "--stats", *mode, "--no-progress"]
     faults = []
     wall, peak, err = peak_of(qdot, env, faults)
     stages = {s: number(rf"{s} ([0-9.e+-]+)", err) / 1e3 for s in STAGES}
@@ -111,6 +115,30 @@ def reuse(build, sizes, stop, repeat):
             print(f"| {n:,} | {names[key]} | {compile_:.2f} / {r['setup']:.2f} / {r['step1']:.2f} / **{r['first']:.2f}** "
                   f"| {r['peak']:.0f} | {r['faults']:,} | **{r['first'] / best['glibc']['first']:.2f}** "
                   f"| {hand:.2f} |".replace(",", " "))
+
+
+MODES = [("default (VM first, JIT in the background)", ()), ("--backend bytecode", ("--backend", "bytecode")),
+         ("--jit-wait", ("--jit-wait",))]
+
+
+def modes(build, sizes, stop, repeat):
+    """Peak memory and file -> first step in each backend mode, alternating, best of `repeat` (by
+    peak), beside the hand-written program's whole run: the 2x memory target holds for every mode."""
+    print(f"\n## Backend modes: peak memory and file → first step of the spring chain (horizon {stop:g} s, "
+          f"best of {repeat})\n")
+    print("| n | mode | peak [MiB] | **peak / hand-written** | file → first step [s] | hand-written peak [MiB] |")
+    print("| ---: | --- | ---: | ---: | ---: | ---: |")
+    for n in sizes:
+        runs = {name: [] for name, _ in MODES}
+        for _ in range(repeat):
+            for name, mode in MODES:
+                runs[name].append(measure(build, n, stop, mode=mode))
+        hand = min(r["hpeak"] for v in runs.values() for r in v)
+        for name, _ in MODES:
+            best = min(runs[name], key=lambda r: r["peak"])
+            size = f"{n:,}".replace(",", " ")
+            print(f"| {size} | {name} | {best['peak']:.0f} | **{best['peak'] / hand:.2f}** | {best['first']:.2f} "
+                  f"| {hand:.0f} |")
 
 
 def whole(build, n, stop, repeat):
@@ -289,6 +317,8 @@ def main():
     ap.add_argument("--exe-sizes", default=None, help="n for the executables table (default 1000,100000,1000000; 'none' skips it)")
     ap.add_argument("--reuse-sizes", default=None,
                     help="n for the freed-memory table (default 100000,1000000, with --quick 100000; 'none' skips it)")
+    ap.add_argument("--mode-sizes", default=None,
+                    help="n for the backend-modes table (default 1000000, with --quick 100000; 'none' skips it)")
     a = ap.parse_args()
     sizes = [int(s) for s in a.sizes.split(",")] if a.sizes else ([1000, 10000, 100000] if a.quick else
                                                                    [1000, 10000, 100000, 1000000])
@@ -329,6 +359,9 @@ def main():
         reuse_sizes = [int(s) for s in a.reuse_sizes.split(",")] if a.reuse_sizes else (
             [100000] if a.quick else [100000, 1000000])
         reuse(a.build, reuse_sizes, a.stop, max(a.repeat, 2))
+    if a.mode_sizes != "none":
+        mode_sizes = [int(s) for s in a.mode_sizes.split(",")] if a.mode_sizes else ([100000] if a.quick else [1000000])
+        modes(a.build, mode_sizes, a.stop, max(a.repeat, 2))
     if a.whole_sizes != "none":
         whole_sizes = [int(s) for s in a.whole_sizes.split(",")] if a.whole_sizes else (
             [1000, 10000] if a.quick else [1000, 10000, 100000])
