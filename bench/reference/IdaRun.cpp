@@ -9,6 +9,7 @@
 #include "arkode/StartLinearization.h"
 #include "ida/DiagonalRates.h"
 #include "ida/KluOrdering.h"
+#include "sim/ProcessClock.h"
 
 #include <ida/ida.h>
 #include <ida/ida_ls.h>
@@ -333,6 +334,7 @@ RunResult simulateReference(const ReferenceModel& model, const RunSettings& sett
   result.solveSeconds = secondsSince(clock);
   result.firstStepSeconds =
       ida.firstStepDone ? std::chrono::duration<double>(*ida.firstStepDone - clock).count() : result.solveSeconds;
+  if (ida.firstStepDone) result.firstStepSinceProcessStart = rt::secondsSinceProcessStart(*ida.firstStepDone);
   ida.readCounters(result);
   return result;
 }
@@ -343,6 +345,10 @@ std::string formatStats(const RunResult& r) {
   std::string solver = !r.sparse     ? "dense"
                        : r.bandwidth ? "klu (band ordering, bandwidth " + std::to_string(*r.bandwidth) + ")"
                                      : "klu";
+  char started[96] = "";
+  if (r.firstStepSinceProcessStart)
+    std::snprintf(started, sizeof started, ", done %.3f s after the process started", *r.firstStepSinceProcessStart);
+  std::string sinceStart = started;
   std::snprintf(text, sizeof text,
                 "statistics:\n"
                 "  steps                  %ld (last step %.3g, order %d)\n"
@@ -355,13 +361,14 @@ std::string formatStats(const RunResult& r) {
                 "  initial values         %s\n"
                 "  tolerances             rtol %g, atol min %.3g, median %.3g, max %.3g\n"
                 "  rows written           %zu\n"
-                "  wall time              setup %.6f s, solve %.6f s (first step %.6f s)\n",
+                "  wall time              setup %.6f s, solve %.6f s (first step %.6f s%s)\n",
                 r.steps, r.lastStep, r.lastOrder, r.residualEvaluations, r.jacobianEvaluations, r.nonlinearIterations,
                 r.errorTestFailures, r.convergenceFailures, solver.c_str(),
                 !r.computedInitialValues ? "consistent as given"
                 : r.diagonalRates        ? "made consistent directly (dF/dy' diagonal: y' -= F/diag, checked)"
                                          : "made consistent by IDACalcIC",
-                t.rtol, t.atolMin, t.atolMedian, t.atolMax, r.rows, r.setupSeconds, r.solveSeconds, r.firstStepSeconds);
+                t.rtol, t.atolMin, t.atolMedian, t.atolMax, r.rows, r.setupSeconds, r.solveSeconds, r.firstStepSeconds,
+                sinceStart.c_str());
   return text;
 }
 

@@ -45,6 +45,7 @@ struct RunResult {
   double setupSeconds = 0;  ///< IDA set up, consistent start
   double solveSeconds = 0;  ///< IDASolve over the output grid, and writing the rows
   double firstStepSeconds = 0;  ///< from the start of the solve to IDA's first completed step
+  std::optional<double> firstStepSinceProcessStart;  ///< the same instant, from the process's start
 };
 
 /// The output times: start + k·interval while below stop (closer than 1e-9 intervals counts as

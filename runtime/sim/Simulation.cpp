@@ -300,8 +300,10 @@ SimulationResult simulateWith(const QdotModel& model, const SimulationSettings& 
   (solving ? result.solveSeconds : result.setupSeconds) = secondsSince(clock);
   result.firstStepSeconds = result.solveSeconds;
   if constexpr (requires(Session& s) { s.firstStepDone(); })
-    if (solving && session->firstStepDone())
+    if (solving && session->firstStepDone()) {
       result.firstStepSeconds = std::chrono::duration<double>(*session->firstStepDone() - clock).count();
+      result.firstStepDone = session->firstStepDone();
+    }
   result.peakMemoryBytes = peakResidentBytes();
   result.prefaultedBytes = heapPrefaultedBytes();
   try {

@@ -3,6 +3,8 @@
 // time and the message; the rows written before a failure stay written.
 #pragma once
 
+#include <chrono>
+
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -90,6 +92,9 @@ struct SimulationResult {
   /// Wall time from the start of the solve to IDA's first completed step (its first matrix
   /// factorization included); the whole solve if that was not seen (ARKODE, a run of one step).
   double firstStepSeconds = 0;
+  /// When IDA's first step was seen done (steady clock), if it was: `--stats` says how long after
+  /// the process started that was (sim/ProcessClock.h), the way from the file to the first step.
+  std::optional<std::chrono::steady_clock::time_point> firstStepDone;
   /// The process's peak resident memory when the run ended (compiling included, for `qdot run`),
   /// in bytes; 0 where the system does not say.
   size_t peakMemoryBytes = 0;

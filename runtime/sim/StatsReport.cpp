@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include "arkode/ArkodeSession.h"
+#include "sim/ProcessClock.h"
 
 namespace qdot::rt {
 namespace {
@@ -62,9 +63,11 @@ std::string formatStats(const SimulationResult& r) {
                                          : "consistent as given");
   line(out, "tolerances", toleranceText(r.tolerances));
   line(out, "rows written", fmt::format("{}", r.rows));
+  std::optional<double> sinceStart = r.firstStepDone ? secondsSinceProcessStart(*r.firstStepDone) : std::nullopt;
   line(out, "wall time",
-       fmt::format("setup {:.3f} s, solve {:.3f} s (first step {:.3f} s)", r.setupSeconds, r.solveSeconds,
-                   r.firstStepSeconds));
+       fmt::format("setup {:.3f} s, solve {:.3f} s (first step {:.3f} s{})", r.setupSeconds, r.solveSeconds,
+                   r.firstStepSeconds,
+                   sinceStart ? fmt::format(", done {:.3f} s after the process started", *sinceStart) : ""));
   if (r.peakMemoryBytes)  // a large model's memory is a figure users compare, as its time
     line(out, "peak memory",
          fmt::format("{:.1f} MiB resident (the whole process so far){}", r.peakMemoryBytes / 1048576.0,

@@ -2,9 +2,12 @@
 // system gives no figure.
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <optional>
 #include <vector>
 
 #include "sim/PeakMemory.h"
+#include "sim/ProcessClock.h"
 #include "sim/StatsReport.h"
 
 namespace qdot::rt {
@@ -21,6 +24,27 @@ TEST(StatsReport, PeakMemoryIsReportedInMebibytesWhenKnown) {
       << formatStats(r);
   r.peakMemoryBytes = 0;
   EXPECT_EQ(formatStats(r).find("peak memory"), std::string::npos);
+}
+
+// "file → first step" is the first step's instant counted from the process's start (the kernel's
+// record of it, in ticks of 10 ms): an instant 50 ms later is 50 ms further, and this test's own
+// process started less than a minute before it.
+TEST(StatsReport, FirstStepIsTimedFromTheProcessStart) {
+  SimulationResult r;
+  EXPECT_EQ(formatStats(r).find("after the process started"), std::string::npos) << "no first step seen: not said";
+#if defined(__linux__)
+  auto now = std::chrono::steady_clock::now();
+  std::optional<double> since = secondsSinceProcessStart(now);
+  ASSERT_TRUE(since.has_value());
+  EXPECT_GE(*since, 0.0);
+  EXPECT_LT(*since, 60.0);
+  std::optional<double> later = secondsSinceProcessStart(now + std::chrono::milliseconds(50));
+  ASSERT_TRUE(later.has_value());
+  EXPECT_NEAR(*later - *since, 0.05, 0.005);
+  r.firstStepDone = now;
+  EXPECT_NE(formatStats(r).find("(first step 0.000 s, done "), std::string::npos) << formatStats(r);
+  EXPECT_NE(formatStats(r).find(" s after the process started)"), std::string::npos) << formatStats(r);
+#endif
 }
 
 #if defined(__linux__)
