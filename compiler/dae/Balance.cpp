@@ -56,7 +56,7 @@ class IncidenceBuilder {
         if (visited_.size() == kSmall) return addAllSymbols(equation, residual);
         visited_.push_back(n);
         stack_.insert(stack_.end(), n->args.begin(), n->args.end());
-        stack_.insert(stack_.end(), n->exps.begin(), n->exps.end());
+        stack_.insert(stack_.end(), n->exps().begin(), n->exps().end());
       }
     }
   }

@@ -103,7 +103,7 @@ class Eliminator {
 
   // ∂r/∂z if it is a number (r is then affine in z), else 0.
   double coefficientOf(sym::Expr r, sym::Expr zs) {
-    if (int at = directTerm(r, zs); at >= 0) return r->coefs[at];
+    if (int at = directTerm(r, zs); at >= 0) return r->coefs()[at];
     sym::Expr d = ctx_.diff(r, zs);
     return d->isConstant() ? d->value : 0;
   }
@@ -112,7 +112,7 @@ class Eliminator {
   sym::Expr replaced(sym::Expr e, sym::Expr zs, sym::Expr value) {
     int at = directTerm(e, zs);
     if (at < 0) return ctx_.substitute(e, {{zs, value}});
-    return combination(e, at, 1.0, value, e->coefs[at]);
+    return combination(e, at, 1.0, value, e->coefs()[at]);
   }
 
   bool eliminate(int z) {
@@ -157,7 +157,7 @@ class Eliminator {
     std::vector<sym::Expr> terms{ctx_.one()};
     std::vector<double> coefs{k * e->value};
     for (size_t i = 0; i < e->args.size(); ++i)
-      if (static_cast<int>(i) != skip) terms.push_back(e->args[i]), coefs.push_back(k * e->coefs[i]);
+      if (static_cast<int>(i) != skip) terms.push_back(e->args[i]), coefs.push_back(k * e->coefs()[i]);
     if (value) terms.push_back(value), coefs.push_back(c);
     return ctx_.linearCombination(terms, coefs);
   }

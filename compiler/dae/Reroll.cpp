@@ -186,18 +186,18 @@ class Reroller {
     std::vector<std::pair<Expr, size_t>> stack{{s.value, 0}};
     while (!stack.empty()) {
       auto& [n, next] = stack.back();
-      size_t kids = n->args.size() + n->exps.size();
+      size_t kids = n->args.size() + n->exps().size();
       if (next < kids) {
-        Expr c = next < n->args.size() ? n->args[next] : n->exps[next - n->args.size()];
+        Expr c = next < n->args.size() ? n->args[next] : n->exps()[next - n->args.size()];
         ++next;
         if (!hashes_.count(c)) stack.push_back({c, 0});
         continue;
       }
       uint64_t h = mix(static_cast<uint64_t>(n->kind), bits(n->value));
       if (n->isSymbol()) h = mix(h, static_cast<uint64_t>(slotA_[n->symbolId]) + 1);
-      for (double c : n->coefs) h = mix(h, bits(c));
+      for (double c : n->coefs()) h = mix(h, bits(c));
       for (Expr c : n->args) h = mix(h, hashes_.at(c));
-      for (Expr c : n->exps) h = mix(h, hashes_.at(c));
+      for (Expr c : n->exps()) h = mix(h, hashes_.at(c));
       hashes_.emplace(n, h);
       stack.pop_back();
     }
@@ -222,11 +222,11 @@ class Reroller {
         continue;
       }
       same = a->kind == b->kind && bits(a->value) == bits(b->value) && a->args.size() == b->args.size() &&
-             a->exps.size() == b->exps.size() && a->coefs.size() == b->coefs.size() &&
-             std::equal(a->coefs.begin(), a->coefs.end(), b->coefs.begin(), [](double u, double v) { return bits(u) == bits(v); }) &&
+             a->exps().size() == b->exps().size() && a->coefs().size() == b->coefs().size() &&
+             std::equal(a->coefs().begin(), a->coefs().end(), b->coefs().begin(), [](double u, double v) { return bits(u) == bits(v); }) &&
              (!a->isSymbol() || slotA_[a->symbolId] == slotB_[b->symbolId]);
       for (size_t k = 0; same && k < a->args.size(); ++k) stack.push_back({a->args[k], b->args[k]});
-      for (size_t k = 0; same && k < a->exps.size(); ++k) stack.push_back({a->exps[k], b->exps[k]});
+      for (size_t k = 0; same && k < a->exps().size(); ++k) stack.push_back({a->exps()[k], b->exps()[k]});
     }
     resetSlots(slotA_, x);
     resetSlots(slotB_, y);

@@ -48,9 +48,9 @@ bool isUnknownOrCoordinate(const Variable& v) { return v.role == VarRole::Unknow
 /// A residual c*x + d*y with |c| = |d| (`x = y`, `x = -y`, `x + y = 0`): (x, y, sign) with x = sign*y.
 std::optional<std::tuple<Expr, Expr, int>> symbolPair(Expr r) {
   if (r->kind != sym::Kind::Add || r->value != 0 || r->args.size() != 2 || !r->args[0]->isSymbol() ||
-      !r->args[1]->isSymbol() || std::abs(r->coefs[0]) != std::abs(r->coefs[1]))
+      !r->args[1]->isSymbol() || std::abs(r->coefs()[0]) != std::abs(r->coefs()[1]))
     return std::nullopt;
-  return std::tuple{r->args[0], r->args[1], r->coefs[0] == r->coefs[1] ? -1 : 1};
+  return std::tuple{r->args[0], r->args[1], r->coefs()[0] == r->coefs()[1] ? -1 : 1};
 }
 
 }  // namespace
@@ -58,7 +58,7 @@ std::optional<std::tuple<Expr, Expr, int>> symbolPair(Expr r) {
 std::optional<std::pair<Expr, int>> signedSymbol(Expr e) {
   if (e->isSymbol()) return std::pair{e, 1};
   if (e->kind == sym::Kind::Mul && (e->value == 1 || e->value == -1) && e->args.size() == 1 && e->args[0]->isSymbol() &&
-      e->exps[0]->isOne())
+      e->exps()[0]->isOne())
     return std::pair{e->args[0], e->value > 0 ? 1 : -1};
   return std::nullopt;
 }

@@ -102,7 +102,7 @@ class Reroller {
     if (e->isSymbol()) return member(e) ? member(e)->number : 0;
     for (Expr a : e->args)
       if (long n = anchorOf(a)) return n;
-    for (Expr a : e->exps)
+    for (Expr a : e->exps())
       if (long n = anchorOf(a)) return n;
     return 0;
   }
@@ -111,7 +111,7 @@ class Reroller {
   // number, which differs by q - p.
   bool sameShape(Expr a, long p, Expr b, long q) const {
     if (a == b && p == q) return true;
-    if (a->kind != b->kind || a->value != b->value || a->args.size() != b->args.size() || a->exps.size() != b->exps.size())
+    if (a->kind != b->kind || a->value != b->value || a->args.size() != b->args.size() || a->exps().size() != b->exps().size())
       return false;
     if (a->isSymbol()) {
       const Member* ma = member(a);
@@ -120,11 +120,11 @@ class Reroller {
       return ma->family == mb->family && ma->number - p == mb->number - q;
     }
     if (a->isConstant()) return true;
-    if (!std::equal(a->coefs.begin(), a->coefs.end(), b->coefs.begin(), b->coefs.end())) return false;
+    if (!std::equal(a->coefs().begin(), a->coefs().end(), b->coefs().begin(), b->coefs().end())) return false;
     for (size_t k = 0; k < a->args.size(); ++k)
       if (!sameShape(a->args[k], p, b->args[k], q)) return false;
-    for (size_t k = 0; k < a->exps.size(); ++k)
-      if (!sameShape(a->exps[k], p, b->exps[k], q)) return false;
+    for (size_t k = 0; k < a->exps().size(); ++k)
+      if (!sameShape(a->exps()[k], p, b->exps()[k], q)) return false;
     return true;
   }
 

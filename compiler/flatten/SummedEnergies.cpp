@@ -125,7 +125,7 @@ class Summation {
       std::vector<Expr> others;
       std::vector<double> coefs;
       for (size_t k = 0; k < r->args.size(); ++k)
-        if (static_cast<int>(k) != pick) others.push_back(r->args[k]), coefs.push_back(-r->coefs[k] / r->coefs[pick]);
+        if (static_cast<int>(k) != pick) others.push_back(r->args[k]), coefs.push_back(-r->coefs()[k] / r->coefs()[pick]);
       given[m_.variableOf(r->args[pick])] = 1;
       balances_.push_back({r->args[pick], ctx_.linearCombination(others, coefs)});
     }

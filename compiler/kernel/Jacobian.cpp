@@ -43,7 +43,7 @@ std::vector<sym::Expr> scalarUnknowns(const dae::Dae& dae, std::span<const int32
     stack.pop_back();
     if (n->isSymbol() && unknowns.find(n)) out.push_back(n);
     for (sym::Expr c : n->args) push(c);
-    for (sym::Expr c : n->exps) push(c);
+    for (sym::Expr c : n->exps()) push(c);
   }
   return out;
 }

@@ -137,7 +137,7 @@ uint32_t ProgramBuilder::appendIndexTable(std::span<const uint32_t> values) {
 sym::Expr ProgramBuilder::nextChild(Frame& f) const {
   sym::Expr e = f.node;
   if (e->isSymbol()) return f.next++ == 0 ? temporaries_.get(e->symbolId) : nullptr;
-  while (f.next < e->args.size() + e->exps.size()) {
+  while (f.next < e->args.size() + e->exps().size()) {
     size_t i = f.next++;
     sym::Expr c = e->args.data()[i];  // args, then exps (one array)
     bool exponent = e->kind == sym::Kind::Pow ? i == 1 : i >= e->args.size();
@@ -193,18 +193,18 @@ uint32_t ProgramBuilder::emitAdd(sym::Expr e) {
   uint32_t acc = kNone;
   size_t j = 0, n = e->args.size();
   auto term = [&](size_t i) {
-    double k = e->coefs[i];
+    double k = e->coefs()[i];
     uint32_t x = reg(e->args[i]);
     return k == 1.0 ? x : k == -1.0 ? emit(Op::Neg, x) : emit(Op::Mul, constant(k), x);
   };
   if (e->value != 0.0) {
     acc = constant(e->value);
-  } else if (n >= 2 && e->coefs[0] == -1.0) {  // -x0 + k1*x1 == k1*x1 - x0 exactly
+  } else if (n >= 2 && e->coefs()[0] == -1.0) {  // -x0 + k1*x1 == k1*x1 - x0 exactly
     acc = emit(Op::Sub, term(1), reg(e->args[0]));
     j = 2;
   }
   for (; j < n; ++j) {
-    double k = e->coefs[j];
+    double k = e->coefs()[j];
     if (acc == kNone) acc = term(j);
     else if (k == -1.0) acc = emit(Op::Sub, acc, reg(e->args[j]));
     else acc = emit(Op::Add, acc, term(j));
@@ -219,13 +219,13 @@ uint32_t ProgramBuilder::emitMul(sym::Expr e) {
   uint32_t acc = k == 1.0 || k == -1.0 ? kNone : constant(k);
   size_t n = e->args.size();
   for (size_t j = 0; j < n; ++j) {
-    sym::Expr x = e->exps[j];
+    sym::Expr x = e->exps()[j];
     if (x->isConstant() && x->value < 0) continue;
     uint32_t f = x->isConstant() ? power(reg(e->args[j]), x->value) : emit(Op::Pow, reg(e->args[j]), reg(x));
     acc = acc == kNone ? f : emit(Op::Mul, acc, f);
   }
   for (size_t j = 0; j < n; ++j) {
-    sym::Expr x = e->exps[j];
+    sym::Expr x = e->exps()[j];
     if (!x->isConstant() || x->value >= 0) continue;
     uint32_t g = power(reg(e->args[j]), -x->value);
     acc = emit(Op::Div, acc == kNone ? constant(1.0) : acc, g);

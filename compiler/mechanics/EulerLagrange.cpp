@@ -117,11 +117,11 @@ class Deriver {
   bool addSummands(TermIndex& idx, Expr e, double sign) {
     bool allowed = true;
     if (e->kind == sym::Kind::Add) {
-      for (size_t i = 0; i < e->args.size(); ++i) allowed &= addSummands(idx, ctx_.scale(sign * e->coefs[i], e->args[i]), 1.0);
+      for (size_t i = 0; i < e->args.size(); ++i) allowed &= addSummands(idx, ctx_.scale(sign * e->coefs()[i], e->args[i]), 1.0);
     } else if (Expr sum = distributedSum(e)) {
       Expr rest = ctx_.div(e, sum);  // the other factors and the coefficient
       for (size_t i = 0; i < sum->args.size(); ++i)
-        allowed &= addSummands(idx, ctx_.mul(rest, ctx_.scale(sign * sum->coefs[i], sum->args[i])), 1.0);
+        allowed &= addSummands(idx, ctx_.mul(rest, ctx_.scale(sign * sum->coefs()[i], sum->args[i])), 1.0);
       if (sum->value != 0) allowed &= addSummands(idx, ctx_.scale(sign * sum->value, rest), 1.0);
     } else if (!e->isConstant()) {
       allowed = addTerm(idx, ctx_.scale(sign, e));
@@ -136,7 +136,7 @@ class Deriver {
     constexpr size_t kLong = 8;
     if (e->kind != sym::Kind::Mul) return nullptr;
     for (size_t i = 0; i < e->args.size(); ++i)
-      if (e->args[i]->kind == sym::Kind::Add && e->args[i]->args.size() >= kLong && e->exps[i]->isOne()) return e->args[i];
+      if (e->args[i]->kind == sym::Kind::Add && e->args[i]->args.size() >= kLong && e->exps()[i]->isOne()) return e->args[i];
     return nullptr;
   }
 

@@ -25,7 +25,7 @@ Expr scaleExponent(Context& ctx, Expr e, double k) {
 bool isIntegerConstant(Expr e) { return e->isConstant() && isIntegerValue(e->value); }
 
 // Drops the numeric coefficient of a Mul (the result may be an Add when the Mul was c*(sum)).
-Expr stripCoefficient(Context& ctx, Expr m) { return ctx.impl().makeMul(1.0, m->args, m->exps); }
+Expr stripCoefficient(Context& ctx, Expr m) { return ctx.impl().makeMul(1.0, m->args, m->exps()); }
 
 // Term order of a canonical sum: by term, then coefficient (like terms are then adjacent and are
 // summed in an order that does not depend on the input order).
@@ -55,7 +55,7 @@ void AddBuilder::add(double coef, Expr e) {
 void AddBuilder::addTerms(double coef, Expr sum) {
   constants_.push_back(coef * sum->value);
   reserve(sum->args.size());
-  for (size_t i = 0; i < sum->args.size(); ++i) terms_.push_back({sum->args[i], coef * sum->coefs[i]});
+  for (size_t i = 0; i < sum->args.size(); ++i) terms_.push_back({sum->args[i], coef * sum->coefs()[i]});
 }
 
 // Sorts terms_ by termLess. Large inputs mostly arrive in canonical order already (the terms of a
@@ -111,7 +111,7 @@ Expr AddBuilder::build() {
     args.push_back(t.e);
     coefs.push_back(t.coef);
   }
-  Node n{};
+  NodeKey n{};
   n.kind = Kind::Add;
   n.value = constant;
   n.args = args;
@@ -126,7 +126,7 @@ void MulBuilder::factor(Expr f) {
     scale(f->value);
   } else if (f->kind == Kind::Mul) {
     if (f->value != 1.0) scale(f->value);
-    for (size_t i = 0; i < f->args.size(); ++i) pairs_.push_back({f->args[i], f->exps[i]});
+    for (size_t i = 0; i < f->args.size(); ++i) pairs_.push_back({f->args[i], f->exps()[i]});
   } else if (f->kind == Kind::Pow && !f->args[0]->isConstant() && f->args[0]->kind != Kind::Mul) {
     pairs_.push_back({f->args[0], f->args[1]});
   } else {
@@ -140,7 +140,7 @@ void MulBuilder::power(Expr b, Expr e) {
     if (b->isConstant()) return scale(powValue(b->value, e->value));
     if (b->kind == Kind::Mul && isIntegerValue(e->value)) {
       scale(powValue(b->value, e->value));
-      for (size_t i = 0; i < b->args.size(); ++i) power(b->args[i], scaleExponent(ctx_, b->exps[i], e->value));
+      for (size_t i = 0; i < b->args.size(); ++i) power(b->args[i], scaleExponent(ctx_, b->exps()[i], e->value));
       return;
     }
     if (b->kind != Kind::Pow) {
@@ -298,7 +298,7 @@ Expr Context::pow(Expr base, Expr exponent) {
     }
   }
   Expr args[] = {base, exponent};
-  Node n{};
+  NodeKey n{};
   n.kind = Kind::Pow;
   n.args = args;
   return impl_->intern(n);

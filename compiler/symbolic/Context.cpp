@@ -13,6 +13,7 @@
 #include <utility>
 #include <stdexcept>
 
+#include "support/Assert.h"
 #include "symbolic/ContextImpl.h"
 
 namespace qdot::sym {
@@ -46,10 +47,10 @@ uint64_t mix(uint64_t h, uint64_t v) {
   return h ^ (h >> 29);
 }
 
-void computeDerived(Node& n) {
+void computeDerived(NodeKey& n) {
   uint64_t h = mix(static_cast<uint64_t>(n.kind) + 1, n.symbolId);
   h = mix(h, numberBits(n.value));
-  uint64_t mask = n.kind == Kind::Symbol ? symbolBit(&n) : 0;
+  uint64_t mask = n.kind == Kind::Symbol ? uint64_t{1} << (n.symbolId % 64) : 0;
   uint32_t depth = 0;
   for (Expr a : n.args) {
     h = mix(h, a->hash);
@@ -73,14 +74,14 @@ bool sameElements(std::span<const T> a, std::span<const T> b) {
 }
 
 // Numbers compare by bit pattern (they are normalized, so -0 and NaN payloads cannot differ).
-bool shallowEqual(const Node& a, const Node& b) {
+bool shallowEqual(const Node& a, const NodeKey& b) {
   return a.kind == b.kind && a.symbolId == b.symbolId && numberBits(a.value) == numberBits(b.value) &&
-         sameElements(a.args, b.args) && sameElements(a.exps, b.exps) && sameElements(a.coefs, b.coefs);
+         sameElements(a.args, b.args) && sameElements(a.exps(), b.exps) && sameElements(a.coefs(), b.coefs);
 }
 
 }  // namespace
 
-Expr Context::Impl::intern(Node& key) {
+Expr Context::Impl::intern(NodeKey& key) {
   key.value = normalizeNumber(key.value);
   computeDerived(key);
   if ((tableCount + 1) * 2 > tableSize) resizeTable(tableSize ? 2 * tableSize : 1024);
@@ -94,21 +95,22 @@ Expr Context::Impl::intern(Node& key) {
 }
 
 // Copies the node into the arena with its operands right behind it (one allocation, one or two
-// cache lines for a small node): children in one array (args, then exps), then the coefficients.
-Expr Context::Impl::store(const Node& key) {
-  size_t nArgs = key.args.size(), nKids = nArgs + key.exps.size(), nCoefs = key.coefs.size();
-  static_assert(std::is_trivially_destructible_v<Node> && sizeof(Node) == 80 && sizeof(Node) % alignof(Expr) == 0 &&
-                alignof(Expr) == alignof(double) && alignof(Node) >= alignof(Expr));
-  void* bytes = arena.allocateBytes(sizeof(Node) + nKids * sizeof(Expr) + nCoefs * sizeof(double), alignof(Node));
-  Node* n = new (bytes) Node(key);
+// cache lines for a small node): the args, then a Mul's exponents or an Add's coefficients (Node's
+// exps() and coefs() find them there).
+Expr Context::Impl::store(const NodeKey& key) {
+  size_t nArgs = key.args.size();
+  QDOT_ASSERT(key.exps.size() == (key.kind == Kind::Mul ? nArgs : 0), "a Mul has one exponent per base, nothing else has any");
+  QDOT_ASSERT(key.coefs.size() == (key.kind == Kind::Add ? nArgs : 0), "an Add has one coefficient per term, nothing else has any");
+  static_assert(std::is_trivially_destructible_v<Node> && sizeof(Node) == 48 && sizeof(Node) % alignof(Expr) == 0 &&
+                alignof(Expr) == alignof(double) && alignof(Node) >= alignof(Expr) && sizeof(Expr) == sizeof(double));
+  size_t operands = nArgs + key.exps.size() + key.coefs.size();
+  void* bytes = arena.allocateBytes(sizeof(Node) + operands * sizeof(Expr), alignof(Node));
   auto* kids = reinterpret_cast<Expr*>(static_cast<std::byte*>(bytes) + sizeof(Node));
-  auto* coefs = reinterpret_cast<double*>(kids + nKids);
   std::copy(key.args.begin(), key.args.end(), kids);
   std::copy(key.exps.begin(), key.exps.end(), kids + nArgs);
-  std::copy(key.coefs.begin(), key.coefs.end(), coefs);
-  n->args = {kids, nArgs};
-  n->exps = {kids + nArgs, key.exps.size()};
-  n->coefs = {coefs, nCoefs};
+  std::copy(key.coefs.begin(), key.coefs.end(), reinterpret_cast<double*>(kids + nArgs));
+  Node* n = new (bytes) Node{.kind = key.kind, .depth = key.depth, .symbolId = key.symbolId, .hash = key.hash,
+                             .symbolMask = key.symbolMask, .value = key.value, .args = {kids, nArgs}};
   ++nodeCount;
   return n;
 }
@@ -140,11 +142,7 @@ Expr Context::Impl::makeMul(double coef, std::span<const Expr> bases, std::span<
   if (coef == 0.0) return ctx.zero();
   if (bases.empty()) return ctx.constant(coef);
   if (bases.size() == 1 && coef == 1.0) return exps[0]->isOne() ? bases[0] : ctx.pow(bases[0], exps[0]);
-  Node n{};
-  n.kind = Kind::Mul;
-  n.value = coef;
-  n.args = bases;
-  n.exps = exps;
+  NodeKey n{.kind = Kind::Mul, .value = coef, .args = bases, .exps = exps};
   return intern(n);
 }
 
@@ -163,18 +161,13 @@ void Context::clear() {
 
 // The key a number is interned under (normalized: -0 and NaN payloads are one node each).
 namespace {
-Node constantKey(double v) {
-  Node n{};
-  n.kind = Kind::Constant;
-  n.value = normalizeNumber(v);
-  return n;
-}
+NodeKey constantKey(double v) { return {.kind = Kind::Constant, .value = normalizeNumber(v)}; }
 }  // namespace
 
 // Numbers recur constantly (0, 1, 2, -1, 0.5, model parameters): a direct-mapped cache in front
 // of the intern table answers most of them without hashing the node.
 Expr Context::constant(double v) {
-  Node n = constantKey(v);
+  NodeKey n = constantKey(v);
   uint64_t bits = numberBits(n.value);
   auto& slot = impl_->recentConstants[(bits * 0x9E3779B97F4A7C15ull) >> (64 - Impl::kConstantCacheBits)];
   if (slot.node && slot.bits == bits) return slot.node;
@@ -187,7 +180,7 @@ std::vector<Expr> Context::constants(std::span<const double> values) {
   impl_->reserve(0, values.size());  // the table does not move while it is read ahead
   std::vector<uint64_t> hashes(values.size());
   for (size_t i = 0; i < values.size(); ++i) {
-    Node key = constantKey(values[i]);
+    NodeKey key = constantKey(values[i]);
     computeDerived(key);
     hashes[i] = key.hash;
   }
@@ -196,7 +189,7 @@ std::vector<Expr> Context::constants(std::span<const double> values) {
   size_t mask = impl_->tableSize - 1;
   for (size_t i = 0; i < values.size(); ++i) {
     if (i + kAhead < values.size()) __builtin_prefetch(&impl_->table[hashes[i + kAhead] & mask]);
-    Node key = constantKey(values[i]);
+    NodeKey key = constantKey(values[i]);
     out.push_back(impl_->intern(key));
   }
   return out;
@@ -251,9 +244,7 @@ Context::Impl::NameSlot& Context::Impl::nameSlot(std::string_view name, uint64_t
 }
 
 Expr Context::Impl::newSymbol(std::string_view name) {
-  Node n{};
-  n.kind = Kind::Symbol;
-  n.symbolId = static_cast<uint32_t>(symbols.size());
+  NodeKey n{.kind = Kind::Symbol, .symbolId = static_cast<uint32_t>(symbols.size())};
   computeDerived(n);
   Expr s = store(n);
   symbols.push_back(s);

@@ -20,9 +20,22 @@
 
 namespace qdot::sym {
 
+/// What a node is made from before it is interned: kind, value and operands, which may point into
+/// temporary storage (a new node's are copied behind it). intern fills hash, symbolMask and depth.
+struct NodeKey {
+  Kind kind = Kind::Constant;
+  uint32_t symbolId = 0;
+  double value = 0;
+  std::span<const Expr> args;
+  std::span<const double> coefs;  ///< Add: one per term
+  std::span<const Expr> exps;     ///< Mul: one per base
+  uint64_t hash = 0, symbolMask = 0;
+  uint32_t depth = 0;
+};
+
 // --- children: args followed by exps (one array in the arena) -------------------------------------
 
-inline size_t childCount(Expr n) { return n->args.size() + n->exps.size(); }
+inline size_t childCount(Expr n) { return n->args.size() + n->exps().size(); }
 inline std::span<const Expr> children(Expr n) { return {n->args.data(), childCount(n)}; }
 inline Expr child(Expr n, size_t i) { return n->args.data()[i]; }
 /// Starts loading a node and its operands (they follow the node in the arena).
@@ -135,7 +148,7 @@ struct Context::Impl {
   /// Returns the unique node structurally equal to `key`, creating it if new (then its operands
   /// are copied into the arena, so the key's spans may point to temporary storage). Fills the key's
   /// hash, mask and depth and normalizes its value; Add coefficients must already be normalized.
-  Expr intern(Node& key);
+  Expr intern(NodeKey& key);
   /// A Mul node from already canonical, sorted, merged (base, exponent) pairs; applies the
   /// single-factor rules (no factor -> constant, one factor with coef 1 -> base or Pow).
   Expr makeMul(double coef, std::span<const Expr> bases, std::span<const Expr> exps);
@@ -152,7 +165,7 @@ struct Context::Impl {
   void reserve(size_t symbols, size_t nodes);
 
  private:
-  Expr store(const Node& key);
+  Expr store(const NodeKey& key);
   void resizeTable(size_t size);
   void resizeSymbolsByName(size_t size);
 };

@@ -18,7 +18,7 @@ namespace {
 
 // What AddBuilder makes of the single term 1·x.
 Expr sumOfOne(Context& ctx, Expr x) {
-  bool scaledSum = x->kind == Kind::Mul && x->value != 1.0 && x->args.size() == 1 && x->exps[0]->isOne() &&
+  bool scaledSum = x->kind == Kind::Mul && x->value != 1.0 && x->args.size() == 1 && x->exps()[0]->isOne() &&
                    x->args[0]->kind == Kind::Add;
   if (!scaledSum) return x;
   AddBuilder sum(ctx);
@@ -80,7 +80,7 @@ Expr dAdd(const Diff& D) {
   Expr n = D.node;
   TermSum sum(D.ctx);
   D.forEachMoving([&](size_t i) {
-    if (Expr d = D.d(i); !d->isZero()) sum.add(n->coefs[i], d);
+    if (Expr d = D.d(i); !d->isZero()) sum.add(n->coefs()[i], d);
   });
   return sum.build();
 }
@@ -91,11 +91,11 @@ Expr dMul(const Diff& D) {
   TermSum sum(D.ctx);
   size_t m = n->args.size();
   D.forEachMoving([&](size_t i) {
-    Expr dFactor = powRule(D.ctx, n->args[i], n->exps[i], D.d(i), D.d(m + i), nullptr);
+    Expr dFactor = powRule(D.ctx, n->args[i], n->exps()[i], D.d(i), D.d(m + i), nullptr);
     if (dFactor->isZero()) return;  // the mask only said "maybe"
     MulBuilder term(D.ctx, n->value);
     for (size_t j = 0; j < m; ++j)
-      if (j != i) term.pair(n->args[j], n->exps[j]);
+      if (j != i) term.pair(n->args[j], n->exps()[j]);
     term.factor(dFactor);
     sum.add(1.0, term.build());
   });
@@ -143,7 +143,7 @@ Expr dLog(const Diff& D, Expr u, Expr du) {
   }
   if (u->kind == Kind::Add && u->args.size() == 1 && u->args[0]->kind == Kind::Exp) {
     Expr e = u->args[0], v = e->args[0];
-    Expr denominator = c.add(c.scale(u->value, c.unary(Kind::Exp, c.neg(v))), c.constant(u->coefs[0]));
+    Expr denominator = c.add(c.scale(u->value, c.unary(Kind::Exp, c.neg(v))), c.constant(u->coefs()[0]));
     return c.div(c.div(du, e), denominator);
   }
   return c.div(du, u);

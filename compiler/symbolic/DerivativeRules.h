@@ -58,7 +58,7 @@ void Diff::forEachMoving(F&& f) const {
   size_t m = node->args.size();
   if (memo) {
     for (size_t i = 0; i < m; ++i)
-      if (mayMove(node->args[i]) || (!node->exps.empty() && mayMove(node->exps[i]))) f(i);
+      if (mayMove(node->args[i]) || (!node->exps().empty() && mayMove(node->exps()[i]))) f(i);
     return;
   }
   size_t split = std::lower_bound(moving.begin(), moving.end(), m) - moving.begin();

@@ -80,7 +80,7 @@ void Evaluator::run(std::span<const double> values, std::span<double> out) {
       v = values[n->symbolId];
     } else if (n->kind == Kind::Add) {
       v = n->value;
-      for (size_t j = 0; j < n->args.size(); ++j) v += n->coefs[j] * slots_[a[j]];
+      for (size_t j = 0; j < n->args.size(); ++j) v += n->coefs()[j] * slots_[a[j]];
     } else if (n->kind == Kind::Mul) {
       v = n->value;
       size_t m = n->args.size();

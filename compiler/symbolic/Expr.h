@@ -53,11 +53,13 @@ using Expr = const Node*;
 
 /// One immutable node. Fields used depend on the kind:
 ///  Constant: value.     Symbol: symbolId (dense, 0-based, in creation order).
-///  Add: value = constant term; args = terms; coefs = their numeric coefficients.
-///  Mul: value = numeric coefficient; args = bases, exps = exponents (Exprs, often constants).
+///  Add: value = constant term; args = terms; coefs() = their numeric coefficients.
+///  Mul: value = numeric coefficient; args = bases, exps() = exponents (Exprs, often constants).
 ///  every other kind: args in order (Select: cond, then, else).
-/// The operand spans point into the Context's arena (a Mul's exps directly follow its args) and
-/// live as long as the Context; nodes are trivially destructible.
+/// The operands live in the Context's arena right behind the node — args, then a Mul's exponents
+/// or an Add's coefficients, one per arg — for as long as the Context; nodes are trivially
+/// destructible. 48 bytes: a large model has a few symbols per array element, and every stage
+/// writes and reads its nodes (they were 80 bytes with a span each for coefs and exps).
 struct Node {
   static constexpr uint32_t kMaxDepth = (1u << 24) - 1;
   Kind kind;
@@ -67,8 +69,17 @@ struct Node {
   uint64_t symbolMask = 0;  ///< bit (id % 64) set for every symbol below; 0 => constant expression
   double value = 0;
   std::span<const Expr> args;
-  std::span<const double> coefs;  ///< Add only
-  std::span<const Expr> exps;     ///< Mul only
+
+  /// Add only (else empty): the coefficient of each term.
+  std::span<const double> coefs() const {
+    if (kind != Kind::Add) return {};
+    return {reinterpret_cast<const double*>(args.data() + args.size()), args.size()};
+  }
+  /// Mul only (else empty): the exponent of each base.
+  std::span<const Expr> exps() const {
+    if (kind != Kind::Mul) return {};
+    return {args.data() + args.size(), args.size()};
+  }
 
   bool isConstant() const { return kind == Kind::Constant; }
   bool isSymbol() const { return kind == Kind::Symbol; }

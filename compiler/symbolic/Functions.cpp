@@ -41,7 +41,7 @@ Expr absorbingLogic(Context& ctx, Kind k, Expr a, Expr b) {
 Expr Context::unary(Kind k, Expr x) {
   if (!isUnaryKind(k)) throw std::invalid_argument(std::string("unary: not a unary kind: ") + kindSpelling(k));
   if (x->isConstant()) return constant(applyKind(k, x->value));
-  Node n{};
+  NodeKey n{};
   n.kind = k;
   n.args = {&x, 1};
   return impl_->intern(n);
@@ -55,7 +55,7 @@ Expr Context::binary(Kind k, Expr a, Expr b) {
   if (Expr r = absorbingLogic(*this, k, a, b)) return r;
   if (isCommutative(k) && structuralCompare(b, a) < 0) std::swap(a, b);
   Expr args[] = {a, b};
-  Node n{};
+  NodeKey n{};
   n.kind = k;
   n.args = args;
   return impl_->intern(n);
@@ -65,7 +65,7 @@ Expr Context::select(Expr cond, Expr ifTrue, Expr ifFalse) {
   if (cond->isConstant()) return cond->value != 0.0 ? ifTrue : ifFalse;
   if (ifTrue == ifFalse) return ifTrue;
   Expr args[] = {cond, ifTrue, ifFalse};
-  Node n{};
+  NodeKey n{};
   n.kind = Kind::Select;
   n.args = args;
   return impl_->intern(n);

@@ -290,7 +290,7 @@ Expr PartialDerivatives::Impl::derivative(Expr n, std::span<const uint32_t> kids
 bool PartialDerivatives::Impl::sumKey(Expr n, std::span<const uint32_t> kids, std::span<const Expr> d) {
   key.clear();
   for (size_t k = 0; k < kids.size(); ++k)
-    if (d[k] != ctx.zero()) key.push_back(std::bit_cast<uint64_t>(n->coefs[kids[k]])), key.push_back(bitsOf(d[k]));
+    if (d[k] != ctx.zero()) key.push_back(std::bit_cast<uint64_t>(n->coefs()[kids[k]])), key.push_back(bitsOf(d[k]));
   size_t terms = key.size() / 2;
   bool plain = terms == 0 || (terms == 1 && key[0] == std::bit_cast<uint64_t>(1.0));
   return !plain && terms <= 16;
@@ -302,7 +302,7 @@ bool PartialDerivatives::Impl::sumKey(Expr n, std::span<const uint32_t> kids, st
 // the builder's input.
 bool PartialDerivatives::Impl::productKey(Expr n, std::span<const uint32_t> kids, std::span<const Expr> d) {
   size_t m = n->args.size();
-  if (kids.size() != 1 || kids[0] >= m || n->exps[kids[0]] != ctx.one() || d[0] == ctx.zero()) return false;
+  if (kids.size() != 1 || kids[0] >= m || n->exps()[kids[0]] != ctx.one() || d[0] == ctx.zero()) return false;
   size_t a = kids[0];
   if (m - 1 >= 2) {
     if (!otherFactors[a]) {
@@ -310,7 +310,7 @@ bool PartialDerivatives::Impl::productKey(Expr n, std::span<const uint32_t> kids
       for (size_t j = 0; j < m; ++j)
         if (j != a) scratch.push_back(n->args[j]);
       for (size_t j = 0; j < m; ++j)
-        if (j != a) scratch.push_back(n->exps[j]);
+        if (j != a) scratch.push_back(n->exps()[j]);
       std::span<const Expr> all = scratch;
       otherFactors[a] = ctx.impl().makeMul(n->value, all.first(m - 1), all.subspan(m - 1));
     }
@@ -320,7 +320,7 @@ bool PartialDerivatives::Impl::productKey(Expr n, std::span<const uint32_t> kids
   }
   key.resize(4);  // other base and exponent (or none), coefficient, db
   key[0] = m == 2 ? bitsOf(n->args[1 - a]) : 0;
-  key[1] = m == 2 ? bitsOf(n->exps[1 - a]) : 0;
+  key[1] = m == 2 ? bitsOf(n->exps()[1 - a]) : 0;
   key[2] = std::bit_cast<uint64_t>(n->value);
   key[3] = bitsOf(d[0]);
   return true;

@@ -84,7 +84,7 @@ class NodeMap {
   // Nodes sit in the arena in creation order, and traversals meet nodes created together one after
   // another. So the slot keeps their locality: each 4 KiB page of the arena gets a random window of
   // 256 slots (its base hashed from the page number), and a node's offset in its page places it in
-  // that window (nodes are >= 80 bytes apart, so a page's nodes do not collide with each other).
+  // that window (nodes are >= 48 bytes apart, so a page's nodes do not collide with each other).
   // Lookups of neighbouring nodes then share cache lines and pages of the table instead of missing
   // the cache once each; windows of different pages overlap at random, as whole keys would.
   size_t slotOf(Expr k) const {

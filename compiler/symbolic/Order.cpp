@@ -32,8 +32,8 @@ int shallowCompare(Expr a, Expr b) {
 // Decides between nodes whose children are pairwise identical: arity, coefficients, value.
 int tieBreak(Expr a, Expr b) {
   if (int c = cmp(childCount(a), childCount(b))) return c;
-  for (size_t i = 0; i < a->coefs.size(); ++i)
-    if (int c = cmpNumber(a->coefs[i], b->coefs[i])) return c;
+  for (size_t i = 0; i < a->coefs().size(); ++i)
+    if (int c = cmpNumber(a->coefs()[i], b->coefs()[i])) return c;
   return cmpNumber(a->value, b->value);
 }
 

@@ -144,7 +144,7 @@ class Printer {
 
   // One term of a sum with its coefficient's magnitude (the sign is printed by the caller).
   void term(double absCoef, Expr t) {
-    if (t->kind == Kind::Mul) return product(absCoef, t->args, t->exps);  // coefficient is 1
+    if (t->kind == Kind::Mul) return product(absCoef, t->args, t->exps());  // coefficient is 1
     if (t->kind == Kind::Pow) return product(absCoef, std::span<const Expr>(&t->args[0], 1),
                                              std::span<const Expr>(&t->args[1], 1));
     if (absCoef == 1.0) return node(t, Multiplicative);
@@ -162,7 +162,7 @@ class Printer {
     }
     for (size_t k = 0; k < order.size(); ++k) {
       size_t i = order[k];
-      double c = n->coefs[i];
+      double c = n->coefs()[i];
       if (k > 0) text(c < 0.0 ? " - " : " + ");
       else if (c < 0.0) text("-");
       term(std::fabs(c), n->args[i]);
@@ -195,7 +195,7 @@ class Printer {
       case Kind::Add: return sum(n);
       case Kind::Mul:
         if (n->value < 0.0) text("-");
-        return product(std::fabs(n->value), n->args, n->exps);
+        return product(std::fabs(n->value), n->args, n->exps());
       case Kind::Pow:
         return product(1.0, std::span<const Expr>(&n->args[0], 1), std::span<const Expr>(&n->args[1], 1));
       case Kind::Sin:
@@ -249,7 +249,7 @@ std::string toStringGrouped(const Context& ctx, Expr e, const std::function<int(
   Expr sum = e->kind == Kind::Add ? e : nullptr;
   if (e->kind == Kind::Mul) {
     for (size_t i = 0; i < e->args.size(); ++i) {
-      if (e->args[i]->kind != Kind::Add || !e->exps[i]->isOne()) continue;
+      if (e->args[i]->kind != Kind::Add || !e->exps()[i]->isOne()) continue;
       if (sum) return toString(ctx, e);  // two sum factors: no one sum to order
       sum = e->args[i];
     }

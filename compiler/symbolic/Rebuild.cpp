@@ -17,7 +17,7 @@ Expr Context::Impl::rebuild(Expr n, std::span<const Expr> kids) {
     case Kind::Add: {
       AddBuilder sum(ctx);
       sum.addConstant(n->value);
-      for (size_t i = 0; i < n->args.size(); ++i) sum.add(n->coefs[i], kids[i]);
+      for (size_t i = 0; i < n->args.size(); ++i) sum.add(n->coefs()[i], kids[i]);
       return sum.build();
     }
     case Kind::Mul: {

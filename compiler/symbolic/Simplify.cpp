@@ -153,12 +153,12 @@ struct Simplifier::Impl {
       case Kind::Symbol: return Poly::atom(e);
       case Kind::Add: {
         Poly p = Poly::constant(e->value);
-        for (size_t i = 0; i < e->args.size(); ++i) addScaled(p, expand(e->args[i]), e->coefs[i]);
+        for (size_t i = 0; i < e->args.size(); ++i) addScaled(p, expand(e->args[i]), e->coefs()[i]);
         return p;
       }
       case Kind::Mul: {
         Poly p = Poly::constant(e->value);
-        for (size_t i = 0; i < e->args.size(); ++i) p = multiply(p, expandPower(e->args[i], e->exps[i]));
+        for (size_t i = 0; i < e->args.size(); ++i) p = multiply(p, expandPower(e->args[i], e->exps()[i]));
         return p;
       }
       case Kind::Pow: return expandPower(e->args[0], e->args[1]);
@@ -206,7 +206,7 @@ struct Simplifier::Impl {
   // Of u and −u exactly one is "negative": the one whose first term (or coefficient) is negative.
   static bool negative(Expr u) {
     if (u->kind == Kind::Mul) return u->value < 0;
-    if (u->kind == Kind::Add) return u->coefs[0] < 0;
+    if (u->kind == Kind::Add) return u->coefs()[0] < 0;
     return false;
   }
   Expr negate(Expr u) {
@@ -599,13 +599,13 @@ namespace {
 // Whether u is a ± b of two symbols (coefficients ±1, no constant).
 bool isSymbolPair(Expr u) {
   return u->kind == Kind::Add && u->value == 0.0 && u->args.size() == 2 && u->args[0]->isSymbol() &&
-         u->args[1]->isSymbol() && std::abs(u->coefs[0]) == 1.0 && std::abs(u->coefs[1]) == 1.0;
+         u->args[1]->isSymbol() && std::abs(u->coefs()[0]) == 1.0 && std::abs(u->coefs()[1]) == 1.0;
 }
 
 // sin/cos(k0 a + k1 b) with k = ±1, from sin(k a) = k sin a and cos(k a) = cos a.
 Expr expandedAngle(Context& ctx, Expr f) {
   Expr u = f->args[0], a = u->args[0], b = u->args[1];
-  double ka = u->coefs[0], kb = u->coefs[1];
+  double ka = u->coefs()[0], kb = u->coefs()[1];
   Expr sa = ctx.scale(ka, ctx.unary(Kind::Sin, a)), ca = ctx.unary(Kind::Cos, a);
   Expr sb = ctx.scale(kb, ctx.unary(Kind::Sin, b)), cb = ctx.unary(Kind::Cos, b);
   if (f->kind == Kind::Sin) return ctx.add(ctx.mul(sa, cb), ctx.mul(ca, sb));
@@ -642,7 +642,7 @@ bool worthSimplifying(Expr e, SimplifyLevel level) {
         if (!n->args[1]->isConstant() || !isIntegerValue(n->args[1]->value)) return true;
         break;
       case Kind::Mul:
-        for (Expr x : n->exps)
+        for (Expr x : n->exps())
           if (!x->isConstant() || !isIntegerValue(x->value)) return true;
         break;
       default: break;
@@ -661,10 +661,10 @@ size_t expressionCost(Expr e) {
     for (Expr k : children(n)) c += *cost.find(k);
     if (n->kind == Kind::Add) c += n->value != 0.0;
     if (n->kind == Kind::Add)
-      for (double k : n->coefs) c += std::abs(k) != 1.0;
+      for (double k : n->coefs()) c += std::abs(k) != 1.0;
     if (n->kind == Kind::Mul) {
       c += std::abs(n->value) != 1.0;
-      for (Expr x : n->exps) c -= x->isOne();  // x^1 prints as x
+      for (Expr x : n->exps()) c -= x->isOne();  // x^1 prints as x
     }
     cost.insert(n, std::min(c, kCap));
   }

@@ -85,7 +85,7 @@ class Magnitudes {
       seen[e] = 1;
       stack.emplace_back(e, true);
       for (sym::Expr c : e->args) stack.emplace_back(c, false);
-      for (sym::Expr c : e->exps) stack.emplace_back(c, false);
+      for (sym::Expr c : e->exps()) stack.emplace_back(c, false);
     }
   }
   /// Evaluates every node at `values`; then magnitude(e) is available for the roots.
@@ -101,13 +101,13 @@ class Magnitudes {
   double magnitudeOf(sym::Expr e, double value) const {
     if (e->kind == sym::Kind::Add) {
       double s = std::fabs(e->value);
-      for (size_t j = 0; j < e->args.size(); ++j) s += std::fabs(e->coefs[j]) * mag_.at(e->args[j]);
+      for (size_t j = 0; j < e->args.size(); ++j) s += std::fabs(e->coefs()[j]) * mag_.at(e->args[j]);
       return s;
     }
     if (e->kind == sym::Kind::Mul) {
       double s = std::fabs(e->value);
       for (size_t j = 0; j < e->args.size(); ++j)
-        s *= e->exps[j]->isConstant() ? std::pow(mag_.at(e->args[j]), e->exps[j]->value) : std::fabs(value);
+        s *= e->exps()[j]->isConstant() ? std::pow(mag_.at(e->args[j]), e->exps()[j]->value) : std::fabs(value);
       return s;
     }
     return std::fabs(value);

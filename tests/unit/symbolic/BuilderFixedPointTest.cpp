@@ -13,7 +13,7 @@ namespace qdot::sym {
 namespace {
 
 bool isScaledSum(Expr x) {
-  return x->kind == Kind::Mul && x->value != 1.0 && x->args.size() == 1 && x->exps[0]->isOne() &&
+  return x->kind == Kind::Mul && x->value != 1.0 && x->args.size() == 1 && x->exps()[0]->isOne() &&
          x->args[0]->kind == Kind::Add;
 }
 

@@ -66,7 +66,7 @@ TEST_F(Canonical, LikeTermsAreCollected) {
   ASSERT_EQ(t->args.size(), 2u);
   EXPECT_EQ(t->args[0], z);
   EXPECT_EQ(t->args[1], xy);
-  EXPECT_EQ(t->coefs[1], 3.0);
+  EXPECT_EQ(t->coefs()[1], 3.0);
 }
 
 TEST_F(Canonical, ConstantFolding) {
@@ -134,8 +134,8 @@ TEST_F(Canonical, PowersOfEqualBasesAreCollected) {
   EXPECT_EQ(m->value, 1.0);
   ASSERT_EQ(m->args.size(), 3u);
   EXPECT_EQ(m->args[0], x);
-  EXPECT_EQ(m->exps[0], c(2));
-  EXPECT_EQ(m->exps[2], c(-1));
+  EXPECT_EQ(m->exps()[0], c(2));
+  EXPECT_EQ(m->exps()[2], c(-1));
 }
 
 TEST_F(Canonical, NonIntegerPowerOfPowerIsKept) {
@@ -161,7 +161,7 @@ TEST_F(Canonical, NoExpansionNoDistribution) {
   Expr flat = ctx.add(d, z);
   ASSERT_EQ(flat->kind, Kind::Add);
   EXPECT_EQ(flat->args.size(), 3u);
-  EXPECT_EQ(flat->coefs[0], 2.0);
+  EXPECT_EQ(flat->coefs()[0], 2.0);
 }
 
 TEST_F(Canonical, CommutativeFunctionsAreOrdered) {

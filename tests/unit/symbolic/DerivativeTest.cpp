@@ -121,7 +121,7 @@ std::set<Kind> kindsOf(Expr e) {
     if (!seen.insert(n).second) continue;
     kinds.insert(n->kind);
     for (Expr a : n->args) stack.push_back(a);
-    for (Expr x : n->exps) stack.push_back(x);
+    for (Expr x : n->exps()) stack.push_back(x);
   }
   return kinds;
 }

@@ -94,7 +94,7 @@ TEST(Scale, BuildingLargeSumsAndProducts) {
   EXPECT_LT(seconds, 2.0 * kSlack);
   ASSERT_EQ(sum->kind, Kind::Add);
   EXPECT_EQ(sum->args.size(), 1000u);                     // like terms collected
-  EXPECT_EQ(sum->coefs[0], 200.0);
+  EXPECT_EQ(sum->coefs()[0], 200.0);
   EXPECT_EQ(product, ctx.pow(x, ctx.constant(200.0 * (1000 * 1001 / 2 + 1000))));  // Σ exponents
 }
 

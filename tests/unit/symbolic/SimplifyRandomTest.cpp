@@ -18,27 +18,27 @@ namespace {
 // Checks the canonical-form invariants of Expr.h on one node; returns a description or "".
 std::string canonicalViolation(Expr n) {
   if (n->kind == Kind::Add) {
-    if (n->args.size() != n->coefs.size()) return "Add: coefs size";
+    if (n->args.size() != n->coefs().size()) return "Add: coefs size";
     if (n->args.empty()) return "Add: no terms";
-    if (n->args.size() == 1 && n->value == 0 && n->coefs[0] == 1) return "Add: single plain term";
+    if (n->args.size() == 1 && n->value == 0 && n->coefs()[0] == 1) return "Add: single plain term";
     if (n->args.size() == 1 && n->value == 0) return "Add: single scaled term (should be a Mul)";
     for (size_t i = 0; i < n->args.size(); ++i) {
       Expr t = n->args[i];
       if (t->isConstant() || t->kind == Kind::Add) return "Add: constant or Add term";
       if (t->kind == Kind::Mul && t->value != 1) return "Add: term with a coefficient";
-      if (n->coefs[i] == 0) return "Add: zero coefficient";
+      if (n->coefs()[i] == 0) return "Add: zero coefficient";
       if (i > 0 && structuralCompare(n->args[i - 1], t) >= 0) return "Add: terms not strictly sorted";
     }
   }
   if (n->kind == Kind::Mul) {
-    if (n->args.size() != n->exps.size()) return "Mul: exps size";
+    if (n->args.size() != n->exps().size()) return "Mul: exps size";
     if (n->value == 0) return "Mul: zero coefficient";
     if (n->args.empty()) return "Mul: no factors";
     if (n->args.size() == 1 && n->value == 1) return "Mul: single factor with coefficient 1";
     for (size_t i = 0; i < n->args.size(); ++i) {
       Expr b = n->args[i];
       if (b->isConstant() || b->kind == Kind::Mul) return "Mul: constant or Mul base";
-      if (n->exps[i]->isZero()) return "Mul: zero exponent";
+      if (n->exps()[i]->isZero()) return "Mul: zero exponent";
       if (i > 0 && structuralCompare(n->args[i - 1], b) >= 0) return "Mul: bases not strictly sorted";
     }
   }
@@ -67,7 +67,7 @@ std::string firstViolation(Expr root) {
     if (!seen.insert(n).second) continue;
     if (std::string v = canonicalViolation(n); !v.empty()) return v;
     for (Expr a : n->args) stack.push_back(a);
-    for (Expr e : n->exps) stack.push_back(e);
+    for (Expr e : n->exps()) stack.push_back(e);
   }
   return "";
 }

@@ -168,11 +168,11 @@ TEST(Storage, MulOperandsAreOneArray) {
   Expr m = ctx.mul(ctx.pow(x, ctx.constant(2)), ctx.unary(Kind::Sin, y));
   ASSERT_EQ(m->kind, Kind::Mul);
   ASSERT_EQ(m->args.size(), 2u);
-  EXPECT_EQ(m->exps.data(), m->args.data() + m->args.size());  // children: args, then exps
-  EXPECT_TRUE(m->coefs.empty());
+  EXPECT_EQ(m->exps().data(), m->args.data() + m->args.size());  // children: args, then exps
+  EXPECT_TRUE(m->coefs().empty());
   Expr s = ctx.add(x, ctx.scale(3, y));
-  EXPECT_EQ(s->coefs.size(), s->args.size());
-  EXPECT_TRUE(s->exps.empty());
+  EXPECT_EQ(s->coefs().size(), s->args.size());
+  EXPECT_TRUE(s->exps().empty());
 }
 
 }  // namespace
