@@ -276,9 +276,13 @@ int IdaSession::Impl::residualCallback(sunrealtype time, N_Vector yv, N_Vector y
 // stays the 0 it starts with, as before. (The dense matrix keeps IDA's zeroing: only the pattern's
 // entries are scattered into it.)
 void IdaSession::Impl::keepPattern(SUNMatrix J) const {
-  SUNMatZero(J);
+  // The values zeroed; the pattern copied over the index arrays (room for at least one entry even
+  // without any: that slot is zeroed too).
+  sunindextype room = SUNSparseMatrix_NNZ(J);
+  std::fill_n(SUNSparseMatrix_Data(J), room, 0.0);
   std::copy(columnStarts.begin(), columnStarts.end(), SUNSparseMatrix_IndexPointers(J));
-  std::copy(rowIndices.begin(), rowIndices.end(), SUNSparseMatrix_IndexValues(J));
+  sunindextype* rows = std::copy(rowIndices.begin(), rowIndices.end(), SUNSparseMatrix_IndexValues(J));
+  std::fill(rows, SUNSparseMatrix_IndexValues(J) + room, sunindextype{0});
   J->ops->zero = [](SUNMatrix) -> int { return SUNMAT_SUCCESS; };
 }
 
@@ -598,7 +602,6 @@ IdaSession::Impl::StartJacobians IdaSession::Impl::checkStartMatrix() {
   if (model.jacobian(&model, options.t0, data(y), data(yp), p.data(), 0.0, at0.data()) != 0 ||
       model.jacobian(&model, options.t0, data(y), data(yp), p.data(), 1.0, at1.data()) != 0)
     return {};  // a failing Jacobian is reported where IDA meets it, with its message
-  auto names = nameList(model.variableNames, n);
   std::vector<std::string> missing;
   // dF/dy' is J(cj = 1) - J(cj = 0): where |dF/dy| is so large that adding 1 does not change it
   // (a stiffness of 1e300), the difference cannot see the entry, and the column is not declared
@@ -608,7 +611,8 @@ IdaSession::Impl::StartJacobians IdaSession::Impl::checkStartMatrix() {
     bool zero = true;
     for (int32_t k = model.jacobianColumnStarts[c]; k < model.jacobianColumnStarts[c + 1]; ++k)
       zero &= model.isDifferential[c] ? at1[k] - at0[k] == 0 && !unseen(at0[k]) : at0[k] == 0;
-    if (zero) missing.push_back(model.isDifferential[c] ? "der(" + std::string(names[c]) + ")" : std::string(names[c]));
+    if (zero) missing.push_back(model.isDifferential[c] ? "der(" + std::string(model.variableNames[c]) + ")"
+                                                        : std::string(model.variableNames[c]));
   }
   bool dependent = missing.empty() && dummies;
   if (dependent) missing = dependentColumns(at0, at1);
