@@ -48,6 +48,38 @@ class TermIndex {
   std::vector<int> termIds_;
 };
 
+// The points of `box` outside every box of `covered` (f(point) for each, row-major): a box of one
+// dimension has the covered intervals cut out, so a contribution over 10⁶ elements visits its few
+// peeled ones rather than all of them; in more dimensions each point is tested against the boxes.
+template <class F>
+void forEachPointOutside(const flat::Box& box, const std::vector<const flat::Box*>& covered, F&& f) {
+  if (box.size() != 1) {
+    flat::forEachPoint(box, [&](std::span<const long> point, size_t) {
+      for (const flat::Box* c : covered) {
+        bool inside = true;
+        for (size_t d = 0; d < point.size() && inside; ++d) inside = point[d] >= (*c)[d].first && point[d] <= (*c)[d].second;
+        if (inside) return;
+      }
+      f(point);
+    });
+    return;
+  }
+  std::vector<std::pair<long, long>> cuts;
+  for (const flat::Box* c : covered)
+    if ((*c)[0].first <= (*c)[0].second) cuts.push_back((*c)[0]);
+  std::sort(cuts.begin(), cuts.end());
+  auto visit = [&](long first, long last) {
+    for (long i = first; i <= last; ++i) f(std::span<const long>(&i, 1));
+  };
+  long next = box[0].first, last = box[0].second;
+  for (auto [lo, hi] : cuts) {
+    if (lo > last) break;
+    if (lo > next) visit(next, lo - 1);
+    next = std::max(next, hi + 1);
+  }
+  visit(next, last);
+}
+
 class Deriver {
  public:
   Deriver(const flat::FlatModel& m, sym::Context& ctx, DiagnosticEngine& diags, sym::SimplifyLevel level)
@@ -295,7 +327,12 @@ class Deriver {
     std::map<int, std::array<std::vector<Expr>, 4>> parts;  // by flat variable: momentum, position, dissipation, force
     for (const Contribution& c : t.contributions) {
       const auto& a = arrays[c.array];
-      flat::forEachPoint(c.box, [&](std::span<const long> point, size_t) {
+      // A point inside a template row's region of the same array is that row's element (skipped
+      // below in any case): only the others are looked at.
+      std::vector<const flat::Box*> covered;
+      for (const TemplateRow& row : t.rows)
+        if (row.array == c.array) covered.push_back(&row.region);
+      forEachPointOutside(c.box, covered, [&](std::span<const long> point) {
         int q = m_.variableOf(a.elements[flat::linearIndex(a.shape, point)]);
         if (templateOf_[q] >= 0) return;
         int part = c.part == Contribution::Part::Momentum   ? 0
