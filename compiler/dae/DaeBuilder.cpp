@@ -362,17 +362,19 @@ class Builder {
       if (!inOrder(rowOfFlat, patterns.arrays[x]))
         QDOT_UNREACHABLE("template rows of an array whose Euler-Lagrange rows are not in element order");
     for (int x : arrays) {
-      const flat::ArrayVariable a = patterns.arrays[x];
-      if (!inOrder(kinematicRowOfFlat, a)) continue;  // an element without inertia: scalar kinematic rows
-      int first = rowOf(kinematicRowOfFlat, a.elements[0]);
-      flat::ArrayVariable rates{"$der(" + a.name + ")", a.shape, {}};
-      for (Expr e : a.elements) {
+      if (!inOrder(kinematicRowOfFlat, patterns.arrays[x])) continue;  // an element without inertia: scalar kinematic rows
+      // Read by index: adding the rates' array below may move the others.
+      int first = rowOf(kinematicRowOfFlat, patterns.arrays[x].elements[0]);
+      flat::ArrayVariable rates{"$der(" + patterns.arrays[x].name + ")", patterns.arrays[x].shape, {}};
+      rates.elements.reserve(patterns.arrays[x].elements.size());
+      for (Expr e : patterns.arrays[x].elements) {
         int row = rowOf(kinematicRowOfFlat, e);
         rates.elements.push_back(dae_.variables[dae_.links[row - eom_.rows.size()].variable].yp);
         dae_.equations[row].residual = nullptr;
         kinematicTaken_[row - eom_.rows.size()] = 1;
       }
       patterns.arrays.push_back(std::move(rates));
+      const flat::ArrayVariable& a = patterns.arrays[x];
       flat::RelativeElement own{static_cast<int>(patterns.arrays.size()) - 1, {}};
       flat::Box all;
       for (size_t d = 0; d < a.shape.size(); ++d) own.dims.push_back({static_cast<int>(d), 0}), all.push_back({1, a.shape[d]});

@@ -151,6 +151,7 @@ class TemplateDeriver {
   int derivativeArray(int array) {
     if (patterns_.arrays[array].derivative >= 0) return patterns_.arrays[array].derivative;
     flat::ArrayVariable d{"der(" + patterns_.arrays[array].name + ")", patterns_.arrays[array].shape, {}};
+    d.elements.reserve(patterns_.arrays[array].elements.size());
     for (Expr e : patterns_.arrays[array].elements) d.elements.push_back(m_.variables[m_.variables[m_.variableOf(e)].derivative].symbol);
     patterns_.arrays.push_back(std::move(d));
     patterns_.arrays[array].derivative = static_cast<int>(patterns_.arrays.size()) - 1;
