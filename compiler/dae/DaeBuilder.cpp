@@ -250,9 +250,15 @@ class Builder {
   // The symbols of the coordinates' rates `$der(q)`, of the states among them in row order: made
   // in batches (Context::symbols; a large array's names are not all written out at once), with the
   // ids one by one would give.
+  // $der(q) of every state coordinate, in row order. Coordinates that are a whole array of symbols
+  // in order (Context::symbolArray, as flatten makes a declared array's) get theirs as one such
+  // array, $der(x[i]); the others by name, a batch at a time.
   std::vector<Expr> rateSymbols(const std::vector<char>& kindOf, size_t states) {
     constexpr size_t kBatch = 4096;
-    ctx_.reserve(states, 0);  // the name table grows once
+    std::vector<Expr> coordinates;
+    coordinates.reserve(states);
+    for (size_t r = 0; r < eom_.rows.size(); ++r)
+      if (kindOf[r] == Inertial || kindOf[r] == NotInertial) coordinates.push_back(m_.variables[eom_.rows[r].coordinate].symbol);
     std::vector<Expr> rates;
     rates.reserve(states);
     std::string buffer;
@@ -263,14 +269,33 @@ class Builder {
       for (Expr s : ctx_.symbols(names)) rates.push_back(s);
       buffer.clear(), ends.clear();
     };
-    for (size_t r = 0; r < eom_.rows.size(); ++r) {
-      if (kindOf[r] != Inertial && kindOf[r] != NotInertial) continue;  // not a state
-      buffer.append("$der(").append(m_.variables[eom_.rows[r].coordinate].name).append(")");
+    for (size_t k = 0; k < coordinates.size();) {
+      if (size_t count = wholeArrayAt(coordinates, k)) {
+        make();
+        auto array = ctx_.symbolArrayOf(coordinates[k]);
+        std::vector<int> shape(array->shape.begin(), array->shape.end());
+        for (Expr s : ctx_.symbolArray("$der(" + std::string(array->prefix), shape, std::string(array->suffix) + ")")) rates.push_back(s);
+        k += count;
+        continue;
+      }
+      buffer.append("$der(").append(ctx_.symbolName(coordinates[k++])).append(")");
       ends.push_back(buffer.size());
       if (ends.size() == kBatch) make();
     }
     make();
     return rates;
+  }
+
+  // The number of symbols from symbols[k] on that are a whole array of symbols in order, or 0.
+  size_t wholeArrayAt(const std::vector<Expr>& symbols, size_t k) const {
+    auto array = ctx_.symbolArrayOf(symbols[k]);
+    if (!array || array->first != symbols[k]->symbolId) return 0;
+    size_t count = 1;
+    for (int n : array->shape) count *= static_cast<size_t>(n);
+    if (k + count > symbols.size()) return 0;
+    for (size_t j = 0; j < count; ++j)
+      if (symbols[k + j]->symbolId != array->first + j) return 0;
+    return count;
   }
 
   // The kinematic rows q' - der(q) that no template took (templated models only).

@@ -411,7 +411,7 @@ class Reroller {
     std::vector<Expr> elements;
     elements.reserve(members.size());
     for (int m : members) elements.push_back(shapes[m].slots[k].symbol);
-    std::string name = "{" + ctx_.symbolName(elements.front()) + "…" + ctx_.symbolName(elements.back()) + "}";
+    std::string name = "{" + std::string(ctx_.symbolName(elements.front())) + "…" + std::string(ctx_.symbolName(elements.back())) + "}";
     auto [at, fresh] = arrays_.try_emplace(name, 0);
     if (fresh) {
       at->second = static_cast<int>(d_.patterns->arrays.size());

@@ -216,6 +216,7 @@ int Flattener::addDerivative(int var, VarRole role, Expr symbol) {
 // der(x[2]), … in the order derivativeVariable would make them, with their symbols made a batch at
 // a time (Context::symbols). A declaration lowered again after a dependency already has them.
 void Flattener::addCoordinateDerivatives(const Value& coordinates) {
+  if (addCoordinateDerivativeArrays(coordinates)) return;
   std::vector<int> vars;
   NameBuffer names;
   auto make = [&] {
@@ -236,6 +237,30 @@ void Flattener::addCoordinateDerivatives(const Value& coordinates) {
     if (names.full()) make();
   }
   make();
+}
+
+// The coordinates are a whole array of symbols (Context::symbolArray), none with a velocity yet:
+// their velocities and accelerations are two such arrays, der(x[i]) and der(der(x[i])).
+bool Flattener::addCoordinateDerivativeArrays(const Value& coordinates) {
+  if (coordinates.elems.empty()) return false;
+  auto array = ctx_.symbolArrayOf(coordinates.elems[0]);
+  if (!array || array->first != coordinates.elems[0]->symbolId) return false;
+  size_t count = 1;
+  for (int n : array->shape) count *= static_cast<size_t>(n);
+  if (count != coordinates.elems.size()) return false;
+  for (size_t k = 0; k < count; ++k) {
+    Expr x = coordinates.elems[k];
+    if (x->symbolId != array->first + k || out_.variables[out_.variableOf(x)].derivative >= 0) return false;
+  }
+  std::string prefix(array->prefix), suffix(array->suffix);
+  std::vector<int> shape(array->shape.begin(), array->shape.end());
+  std::vector<Expr> velocities = ctx_.symbolArray("der(" + prefix, shape, suffix + ")");
+  std::vector<Expr> accelerations = ctx_.symbolArray("der(der(" + prefix, shape, suffix + "))");
+  for (size_t k = 0; k < count; ++k) {
+    int var = out_.variableOf(coordinates.elems[k]);
+    addDerivative(addDerivative(var, VarRole::Velocity, velocities[k]), VarRole::Acceleration, accelerations[k]);
+  }
+  return true;
 }
 
 // A declaration's value, created on first use. Declarations may use each other in any order, and a
@@ -423,7 +448,6 @@ Value Flattener::variablesFor(const Declaration& d, const std::vector<int>& shap
   // a coordinate brings its velocity and acceleration
   size_t withDerivatives = role == VarRole::Coordinate ? 3 * count : count;
   reserveVariables(withDerivatives);
-  ctx_.reserve(withDerivatives, 0);
   v.elems.reserve(count);
   // A component's variable is located where the model compiled declares the component (`Spring
   // k1;`): what the user can change, rather than a line of the library.
@@ -436,20 +460,13 @@ Value Flattener::variablesFor(const Declaration& d, const std::vector<int>& shap
     if (added) out_.attributes.push_back({.description = d.description});
     attributes = record->second;
   }
-  NameBuffer names;
-  auto make = [&] {
-    for (Expr symbol : ctx_.symbols(names.views())) {
-      addVariable({.role = role, .symbol = symbol, .declRange = where, .attributes = attributes});
-      v.elems.push_back(symbol);
-    }
-    names.clear();
-  };
-  forEachScalarName(cur_->prefix() + d.name, shape, [&](std::string_view name) {
-    names.chars += name;
-    names.finish();
-    if (names.full()) make();
-  });
-  make();
+  // An array's elements are one block of symbols (Context::symbolArray): no name is hashed.
+  std::string name = cur_->prefix() + d.name;
+  std::vector<Expr> symbols = shape.empty() ? std::vector<Expr>{ctx_.symbol(name)} : ctx_.symbolArray(name, shape);
+  for (Expr symbol : symbols) {
+    addVariable({.role = role, .symbol = symbol, .declRange = where, .attributes = attributes});
+    v.elems.push_back(symbol);
+  }
   slot.variables = std::move(v);
   slot.hasVariables = true;
   return slot.variables;

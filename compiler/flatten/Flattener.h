@@ -298,6 +298,7 @@ class Flattener {
   int derivativeVariable(int var, SourceRange where);
   int addDerivative(int var, VarRole role, sym::Expr symbol);
   void addCoordinateDerivatives(const Value& coordinates);
+  bool addCoordinateDerivativeArrays(const Value& coordinates);
   void checkShape(const Value& v, const std::vector<int>& shape, SourceRange r, const std::string& what);
   void countScalars(size_t n, SourceRange r);
   void lowerEquation(const ast::Equation& eq, std::vector<Equation>& into, OriginKind kind);

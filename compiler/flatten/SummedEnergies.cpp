@@ -85,7 +85,7 @@ class Summation {
     };
     for (const Equation& e : m_.equations)  // a connection's balance: every symbol a flow
       for (Expr s : ctx_.freeSymbols(e.residual)) {
-        if (unknown(s) < 0) return "a connection's balance reads '" + ctx_.symbolName(s) + "', which is no flow";
+        if (unknown(s) < 0) return "a connection's balance reads '" + std::string(ctx_.symbolName(s)) + "', which is no flow";
         add(unknown(s));
       }
     for (const auto& [q, t] : m_.forces)

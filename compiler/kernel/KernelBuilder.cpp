@@ -172,7 +172,7 @@ class Builder {
     for (const auto& use : b.unboundSymbols()) {
       SourceRange r = use.source < m_.sources.size() ? m_.sources[use.source].range : SourceRange{};
       diags_.error(r.valid() ? r : dae_.range, DiagCode::E0602,
-                   "'" + ctx_.symbolName(use.symbol) + "' is not available in the " + where, help);
+                   "'" + std::string(ctx_.symbolName(use.symbol)) + "' is not available in the " + where, help);
     }
   }
 

@@ -6,6 +6,9 @@
 // the intern table (a large model has millions; the table would only grow and rehash for them).
 #include <algorithm>
 #include <bit>
+#include <charconv>
+#include <cstring>
+#include <optional>
 #include <cstddef>
 #include <functional>
 #include <new>
@@ -136,6 +139,7 @@ void Context::Impl::reserve(size_t moreSymbols, size_t moreNodes) {
   size_t names = symbols.size() + moreSymbols;
   if (names * 2 > nameTableSize) resizeSymbolsByName(std::bit_ceil(std::max<size_t>(names * 2, 64)));
   if (names > symbols.capacity()) symbols.reserve(std::max(names, 2 * symbols.capacity()));
+  if (names > symbolNames.capacity()) symbolNames.reserve(std::max(names, 2 * symbolNames.capacity()));
 }
 
 Expr Context::Impl::makeMul(double coef, std::span<const Expr> bases, std::span<const Expr> exps) {
@@ -219,18 +223,143 @@ std::vector<Expr> Context::symbols(std::span<const std::string_view> names) {
   return out;
 }
 
+// A name of an array element is its family (what precedes the last `[` and follows the `]` after
+// it) and its subscripts; symbols of a family made by symbolArray are found through both.
+namespace {
+struct SubscriptedName {
+  std::string_view prefix, subscripts, suffix;
+};
+std::optional<SubscriptedName> splitSubscripts(std::string_view name) {
+  size_t open = name.rfind('[');
+  if (open == std::string_view::npos) return std::nullopt;
+  size_t close = name.find(']', open);
+  if (close == std::string_view::npos) return std::nullopt;
+  return SubscriptedName{name.substr(0, open), name.substr(open + 1, close - open - 1), name.substr(close + 1)};
+}
+uint64_t familyHash(std::string_view prefix, std::string_view suffix) {
+  return mix(std::hash<std::string_view>{}(prefix), std::hash<std::string_view>{}(suffix));
+}
+// The row-major index of `i,j,…` (1-based, decimal) in shape, or -1 if not one of its elements.
+long elementIndex(std::string_view subscripts, std::span<const int> shape) {
+  long k = 0;
+  size_t pos = 0;
+  for (size_t d = 0; d < shape.size(); ++d) {
+    size_t end = d + 1 < shape.size() ? subscripts.find(',', pos) : subscripts.size();
+    if (end == std::string_view::npos || end == pos || end - pos > 10) return -1;
+    long v = 0;
+    for (char c : subscripts.substr(pos, end - pos)) {
+      if (c < '0' || c > '9') return -1;
+      v = 10 * v + (c - '0');
+    }
+    if (v < 1 || v > shape[d]) return -1;
+    k = k * shape[d] + (v - 1);
+    pos = end + 1;
+  }
+  return k;
+}
+}  // namespace
+
 Expr Context::Impl::symbol(std::string_view name, uint64_t hash) {
   NameSlot& slot = nameSlot(name, hash);
   if (slot.entry) return symbols[slot.entry - 1];
+  if (!blocks.empty())
+    if (Expr s = findInBlocks(name)) return s;
+  if (auto parts = splitSubscripts(name)) {
+    uint64_t family = familyHash(parts->prefix, parts->suffix);
+    tableFamilies[family % kFamilyBits / 64] |= uint64_t{1} << (family % 64);
+  }
   Expr s = newSymbol(name);
   slot = {static_cast<uint32_t>(hash), s->symbolId + 1};
   return s;
 }
 
+// The stored name is compared at the end, so `x[01]` or `x[1, 2]` find nothing (as in the table).
+Expr Context::Impl::findInBlocks(std::string_view name) const {
+  auto parts = splitSubscripts(name);
+  if (!parts) return nullptr;
+  auto it = blockByFamily.find(familyHash(parts->prefix, parts->suffix));
+  if (it == blockByFamily.end()) return nullptr;
+  const SymbolBlock& b = blocks[it->second];
+  if (b.prefix != parts->prefix || b.suffix != parts->suffix) return nullptr;
+  long k = elementIndex(parts->subscripts, b.shape);
+  if (k < 0) return nullptr;
+  uint32_t id = b.first + static_cast<uint32_t>(k);
+  return symbolNames[id] == name ? symbols[id] : nullptr;
+}
+
+const Context::Impl::SymbolBlock* Context::Impl::blockOf(uint32_t id) const {
+  auto it = std::upper_bound(blocks.begin(), blocks.end(), id, [](uint32_t i, const SymbolBlock& b) { return i < b.first; });
+  if (it == blocks.begin()) return nullptr;
+  --it;
+  return id < it->first + it->count ? &*it : nullptr;
+}
+
+std::string_view Context::Impl::storeName(std::string_view name) {
+  if (name.empty()) return {};
+  char* chars = nameChars.allocate<char>(name.size());
+  std::memcpy(chars, name.data(), name.size());
+  return {chars, name.size()};
+}
+
 Expr Context::findSymbol(std::string_view name) const {
-  if (impl_->nameTableSize == 0) return nullptr;
-  const Impl::NameSlot& slot = impl_->nameSlot(name, std::hash<std::string_view>{}(name));
-  return slot.entry ? impl_->symbols[slot.entry - 1] : nullptr;
+  if (impl_->nameTableSize != 0) {
+    const Impl::NameSlot& slot = impl_->nameSlot(name, std::hash<std::string_view>{}(name));
+    if (slot.entry) return impl_->symbols[slot.entry - 1];
+  }
+  return impl_->blocks.empty() ? nullptr : impl_->findInBlocks(name);
+}
+
+// The names are written straight into the name store and the nodes made in id order: no hashing
+// of names, no name-table slots (a million-element array's three families are 3·10⁶ of each).
+std::vector<Expr> Context::symbolArray(std::string_view prefix, std::span<const int> shape, std::string_view suffix) {
+  size_t count = 1;
+  for (int n : shape) count *= n > 0 ? static_cast<size_t>(n) : 0;
+  uint64_t family = familyHash(prefix, suffix);
+  bool asBlock = !shape.empty() && count > 0 && suffix.find_first_of("[]") == std::string_view::npos &&
+                 impl_->symbols.size() + count < UINT32_MAX && impl_->familyFree(family);
+  std::string name(prefix);
+  std::vector<int> index(shape.size(), 1);
+  char digits[16];
+  auto formatName = [&] {  // prefix[index]suffix, then index advances row-major
+    name.resize(prefix.size());
+    for (size_t d = 0; d < index.size(); ++d) {
+      name += d ? ',' : '[';
+      name.append(digits, std::to_chars(digits, digits + sizeof digits, index[d]).ptr);
+    }
+    name += ']';
+    name += suffix;
+    for (size_t d = index.size(); d-- > 0;) {
+      if (++index[d] <= shape[d]) break;
+      index[d] = 1;
+    }
+  };
+  if (!asBlock) {
+    std::vector<std::string> names;
+    for (size_t k = 0; k < count; ++k) formatName(), names.push_back(name);
+    std::vector<std::string_view> views(names.begin(), names.end());
+    return symbols(views);
+  }
+  Impl& im = *impl_;
+  auto first = static_cast<uint32_t>(im.symbols.size());
+  im.blockByFamily.emplace(family, static_cast<uint32_t>(im.blocks.size()));
+  im.blocks.push_back({first, static_cast<uint32_t>(count), std::string(prefix), std::string(suffix), {shape.begin(), shape.end()}});
+  if (im.symbols.size() + count > im.symbols.capacity()) im.symbols.reserve(std::max(im.symbols.size() + count, 2 * im.symbols.capacity()));
+  if (im.symbolNames.size() + count > im.symbolNames.capacity())
+    im.symbolNames.reserve(std::max(im.symbolNames.size() + count, 2 * im.symbolNames.capacity()));
+  std::vector<Expr> out;
+  out.reserve(count);
+  for (size_t k = 0; k < count; ++k) {
+    formatName();
+    out.push_back(im.newSymbol(name));
+  }
+  return out;
+}
+
+std::optional<Context::SymbolArrayInfo> Context::symbolArrayOf(Expr s) const {
+  if (!s || !s->isSymbol() || impl_->blocks.empty()) return std::nullopt;
+  const Impl::SymbolBlock* b = impl_->blockOf(s->symbolId);
+  if (!b) return std::nullopt;
+  return SymbolArrayInfo{b->prefix, b->suffix, b->shape, b->first};
 }
 
 // Linear probing; a slot whose tag differs cannot hold the name, so most misses compare no string.
@@ -248,7 +377,7 @@ Expr Context::Impl::newSymbol(std::string_view name) {
   computeDerived(n);
   Expr s = store(n);
   symbols.push_back(s);
-  symbolNames.emplace_back(name);
+  symbolNames.push_back(storeName(name));
   return s;
 }
 
@@ -266,7 +395,7 @@ void Context::Impl::resizeSymbolsByName(size_t size) {
   }
 }
 
-const std::string& Context::symbolName(Expr s) const {
+std::string_view Context::symbolName(Expr s) const {
   if (!s || !s->isSymbol() || s->symbolId >= impl_->symbolNames.size() || impl_->symbols[s->symbolId] != s)
     throw std::invalid_argument("symbolName: not a symbol of this Context");
   return impl_->symbolNames[s->symbolId];

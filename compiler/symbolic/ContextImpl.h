@@ -6,7 +6,6 @@
 
 #include <cmath>
 #include <cstring>
-#include <deque>
 #include <limits>
 #include <span>
 #include <string>
@@ -132,8 +131,24 @@ struct Context::Impl {
   static constexpr int kConstantCacheBits = 10;
   /// Direct-mapped cache of recent constants, indexed by a hash of the value's bits.
   std::vector<ConstantSlot> recentConstants = std::vector<ConstantSlot>(size_t{1} << kConstantCacheBits);
-  std::deque<std::string> symbolNames;  ///< by symbolId (deque keeps references stable)
-  std::vector<Expr> symbols;            ///< by symbolId
+  std::vector<std::string_view> symbolNames;  ///< by symbolId; the characters are in nameChars
+  Arena nameChars;                            ///< every symbol's name (stable: views stay valid)
+  std::vector<Expr> symbols;                  ///< by symbolId
+  /// The symbols symbolArray made, one block per array: `prefix[i,j]suffix`, row-major over
+  /// `shape`, with consecutive ids from `first`. They are not in the name table: a name is found
+  /// in its block by its family (prefix and suffix) and its subscripts.
+  struct SymbolBlock {
+    uint32_t first = 0;
+    uint32_t count = 0;
+    std::string prefix, suffix;
+    std::vector<int> shape;
+  };
+  std::vector<SymbolBlock> blocks;                      ///< in order of `first`
+  std::unordered_map<uint64_t, uint32_t> blockByFamily;  ///< family hash -> index in blocks
+  /// A Bloom filter of the families of the subscripted names in the name table: an array whose
+  /// family may be among them is made name by name, through the table (so a name has one symbol).
+  static constexpr size_t kFamilyBits = size_t{1} << 16;
+  std::vector<uint64_t> tableFamilies = std::vector<uint64_t>(kFamilyBits / 64);
   struct NameSlot {  // trivial, like TableSlot: a large table asks for huge pages before it is touched
     uint32_t tag;    ///< low half of the name's hash (all the table's position needs)
     uint32_t entry;  ///< symbolId + 1; 0 = empty
@@ -161,6 +176,16 @@ struct Context::Impl {
   /// A symbol node with the next symbolId, stored without entering the intern table: a symbol is
   /// only ever found by name, never by structure, so the table need not hold (or rehash) it.
   Expr newSymbol(std::string_view name);
+  /// The symbol of a block with this name, or nullptr.
+  Expr findInBlocks(std::string_view name) const;
+  /// The block holding symbol id, or nullptr.
+  const SymbolBlock* blockOf(uint32_t id) const;
+  /// Whether symbolArray may make this family as a block (no name of it can exist yet).
+  bool familyFree(uint64_t family) const {
+    return !(tableFamilies[family % kFamilyBits / 64] >> (family % 64) & 1) && !blockByFamily.contains(family);
+  }
+  /// A copy of the name in nameChars.
+  std::string_view storeName(std::string_view name);
   /// Room for `symbols` more symbols and `nodes` more interned nodes without rehashing.
   void reserve(size_t symbols, size_t nodes);
 

@@ -31,6 +31,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -116,7 +117,20 @@ class Context {
   /// Room for `symbols` more symbols and `nodes` more other nodes: a caller about to make many (a
   /// large array's variables) spares the tables rehashing as they grow. Never changes any result.
   void reserve(size_t symbols, size_t nodes);
-  const std::string& symbolName(Expr s) const;
+  /// An array's element symbols, `prefix[1]suffix`, `prefix[2]suffix`, … (row-major over shape,
+  /// subscripts as `[i,j]`), with consecutive ids: the same symbols as symbols() of those names,
+  /// made without the name table (a large array's are found by their family and subscripts). If a
+  /// name of the family may exist already (or the suffix holds a bracket), made through symbols().
+  std::vector<Expr> symbolArray(std::string_view prefix, std::span<const int> shape, std::string_view suffix = {});
+  /// The array symbolArray made that s is an element of: its prefix, suffix and shape, and the
+  /// first element's id (s is element s->symbolId - first, row-major); nullopt if none.
+  struct SymbolArrayInfo {
+    std::string_view prefix, suffix;
+    std::span<const int> shape;
+    uint32_t first = 0;
+  };
+  std::optional<SymbolArrayInfo> symbolArrayOf(Expr s) const;
+  std::string_view symbolName(Expr s) const;
   size_t symbolCount() const;
 
   // --- arithmetic (all simplify to canonical form) -----------------------------------------

@@ -57,7 +57,7 @@ void expectSameSystem(const std::string& text, std::vector<std::string> integers
   std::map<std::string, double> point;
   for (const auto& v : small.variables) {
     point[v.name] = uniform(random);
-    if (v.yp) point[reduced.c->ctx.symbolName(v.yp)] = uniform(random);
+    if (v.yp) point[std::string(reduced.c->ctx.symbolName(v.yp))] = uniform(random);
   }
   std::vector<double> at = valuesOf(*reduced.c, point);
   for (const auto& o : small.outputs) point[o.name] = sym::evaluate(o.value, at);  // the solved unknowns among them
@@ -133,7 +133,7 @@ end Definitions;
   EXPECT_TRUE(algebraicNames(reduced.dae()).empty());
   for (const auto& o : reduced.dae().outputs)  // every value is over the states only
     for (sym::Expr s : reduced.c->ctx.freeSymbols(o.value)) {
-      std::string name = reduced.c->ctx.symbolName(s);
+      std::string name(reduced.c->ctx.symbolName(s));
       EXPECT_TRUE(name == "x" || name == "der(x)") << o.name << " contains " << name;
     }
   expectSameSystem(text);

@@ -92,7 +92,7 @@ double valueOf(const std::string& name, uint64_t seed) {
 
 double evaluateByName(Compilation& c, sym::Expr e, uint64_t seed) {
   std::vector<double> values(c.ctx.symbolCount());
-  for (sym::Expr s : c.ctx.freeSymbols(e)) values[s->symbolId] = valueOf(c.ctx.symbolName(s), seed);
+  for (sym::Expr s : c.ctx.freeSymbols(e)) values[s->symbolId] = valueOf(std::string(c.ctx.symbolName(s)), seed);
   return sym::evaluate(e, values);
 }
 

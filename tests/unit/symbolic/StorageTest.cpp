@@ -222,3 +222,48 @@ TEST(Storage, ConstantsInOneBatchAreTheConstantsOneByOne) {
   EXPECT_EQ(batch[0], batch[1700]);
   EXPECT_TRUE(ctx.constants({}).empty());
 }
+
+// symbolArray makes an array's element symbols as one block, outside the name table: they are the
+// symbols symbol() finds and makes by those names (one symbol per name, whichever came first),
+// named and ordered as the flattener names elements, and symbolArrayOf finds their array.
+TEST(Storage, SymbolArraysAreFoundByName) {
+  Context ctx;
+  Expr before = ctx.symbol("a");
+  std::vector<int> shape{2, 3};
+  std::vector<Expr> m = ctx.symbolArray("der(M", shape, ")");
+  ASSERT_EQ(m.size(), 6u);
+  const char* names[] = {"der(M[1,1])", "der(M[1,2])", "der(M[1,3])", "der(M[2,1])", "der(M[2,2])", "der(M[2,3])"};
+  for (size_t k = 0; k < m.size(); ++k) {
+    EXPECT_EQ(ctx.symbolName(m[k]), names[k]);
+    EXPECT_EQ(m[k]->symbolId, before->symbolId + 1 + k);
+    EXPECT_EQ(ctx.findSymbol(names[k]), m[k]);
+    EXPECT_EQ(ctx.symbol(names[k]), m[k]);
+    auto info = ctx.symbolArrayOf(m[k]);
+    ASSERT_TRUE(info);
+    EXPECT_EQ(info->prefix, "der(M");
+    EXPECT_EQ(info->suffix, ")");
+    EXPECT_EQ(std::vector<int>(info->shape.begin(), info->shape.end()), shape);
+    EXPECT_EQ(info->first, m[0]->symbolId);
+  }
+  EXPECT_EQ(ctx.symbolCount(), 7u);
+  EXPECT_FALSE(ctx.symbolArrayOf(before));
+  // Not elements: out of range, written differently, another family.
+  for (const char* other : {"der(M[3,1])", "der(M[0,1])", "der(M[1, 2])", "der(M[01,2])", "der(M[1])", "der(M[1,2,1])",
+                            "der(M[1,2]", "M[1,2]", "der(M[x,2])"})
+    EXPECT_EQ(ctx.findSymbol(other), nullptr) << other;
+  Expr outside = ctx.symbol("der(M[3,1])");  // an ordinary symbol of the same family
+  EXPECT_EQ(outside->symbolId, 7u);
+  EXPECT_EQ(ctx.findSymbol("der(M[3,1])"), outside);
+  // A family whose names may be in the table already is made through it: the same symbols.
+  Expr x2 = ctx.symbol("x[2]");
+  std::vector<Expr> x = ctx.symbolArray("x", std::vector<int>{3});
+  ASSERT_EQ(x.size(), 3u);
+  EXPECT_EQ(x[1], x2);
+  EXPECT_FALSE(ctx.symbolArrayOf(x[0]));
+  EXPECT_EQ(ctx.symbolName(x[2]), "x[3]");
+  // A second array of a family already made is made through the names too.
+  std::vector<Expr> again = ctx.symbolArray("der(M", shape, ")");
+  EXPECT_EQ(again, m);
+  // An empty array has no symbols.
+  EXPECT_TRUE(ctx.symbolArray("e", std::vector<int>{0}).empty());
+}
