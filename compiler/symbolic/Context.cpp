@@ -131,15 +131,13 @@ void Context::Impl::resizeTable(size_t size) {
   }
 }
 
-// Each table stays at most half full; the vector of symbols grows geometrically even when callers
-// reserve a little at a time.
+// Each table stays at most half full (the symbols by id grow by chunks and need no reserve).
 void Context::Impl::reserve(size_t moreSymbols, size_t moreNodes) {
   size_t nodes = tableCount + moreNodes;
   if (nodes * 2 > tableSize) resizeTable(std::bit_ceil(std::max<size_t>(nodes * 2, 1024)));
-  size_t names = symbols.size() + moreSymbols;
-  if (names * 2 > nameTableSize) resizeSymbolsByName(std::bit_ceil(std::max<size_t>(names * 2, 64)));
-  if (names > symbols.capacity()) symbols.reserve(std::max(names, 2 * symbols.capacity()));
-  if (names > symbolNames.capacity()) symbolNames.reserve(std::max(names, 2 * symbolNames.capacity()));
+  // the name table holds the symbols not in blocks (symbolArray's are found without it)
+  size_t inTable = symbols.size() - inBlocks + moreSymbols;
+  if (inTable * 2 > nameTableSize) resizeSymbolsByName(std::bit_ceil(std::max<size_t>(inTable * 2, 64)));
 }
 
 Expr Context::Impl::makeMul(double coef, std::span<const Expr> bases, std::span<const Expr> exps) {
@@ -343,15 +341,21 @@ std::vector<Expr> Context::symbolArray(std::string_view prefix, std::span<const 
   auto first = static_cast<uint32_t>(im.symbols.size());
   im.blockByFamily.emplace(family, static_cast<uint32_t>(im.blocks.size()));
   im.blocks.push_back({first, static_cast<uint32_t>(count), std::string(prefix), std::string(suffix), {shape.begin(), shape.end()}});
-  if (im.symbols.size() + count > im.symbols.capacity()) im.symbols.reserve(std::max(im.symbols.size() + count, 2 * im.symbols.capacity()));
-  if (im.symbolNames.size() + count > im.symbolNames.capacity())
-    im.symbolNames.reserve(std::max(im.symbolNames.size() + count, 2 * im.symbolNames.capacity()));
+  im.inBlocks += count;
+  // The nodes in one piece of the arena, made as newSymbol makes each (no intern table).
+  Node* nodes = im.arena.allocate<Node>(count);
   std::vector<Expr> out;
   out.reserve(count);
   for (size_t k = 0; k < count; ++k) {
     formatName();
-    out.push_back(im.newSymbol(name));
+    NodeKey key{.kind = Kind::Symbol, .symbolId = first + static_cast<uint32_t>(k)};
+    computeDerived(key);
+    Expr s = new (nodes + k) Node{.kind = Kind::Symbol, .depth = 0, .symbolId = key.symbolId, .hash = key.hash, .symbolMask = key.symbolMask};
+    im.symbols.push_back(s);
+    im.symbolNames.push_back(im.storeName(name));
+    out.push_back(s);
   }
+  im.nodeCount += count;
   return out;
 }
 

@@ -7,8 +7,10 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <span>
 #include <string>
+#include <type_traits>
 #include <unordered_map>
 #include <vector>
 
@@ -109,6 +111,26 @@ inline PostOrder postOrder(std::span<const Expr> roots) {
   return postOrder(roots, [](Expr) { return true; });
 }
 
+/// A vector that grows by chunks and never moves what it holds: a Context with millions of symbols
+/// adds one more without copying (and first touching twice as much) its tables by symbolId.
+template <class T>
+class ChunkedVector {
+ public:
+  static_assert(std::is_trivially_copyable_v<T>);
+  size_t size() const { return size_; }
+  const T& operator[](size_t i) const { return chunks_[i >> kBits][i & kMask]; }
+  void push_back(const T& v) {
+    if ((size_ >> kBits) == chunks_.size()) chunks_.push_back(std::make_unique_for_overwrite<T[]>(kChunk));
+    chunks_[size_ >> kBits][size_ & kMask] = v;
+    ++size_;
+  }
+
+ private:
+  static constexpr size_t kBits = 16, kChunk = size_t{1} << kBits, kMask = kChunk - 1;
+  std::vector<std::unique_ptr<T[]>> chunks_;
+  size_t size_ = 0;
+};
+
 // --- the Context internals ------------------------------------------------------------------------
 
 struct Context::Impl {
@@ -131,9 +153,9 @@ struct Context::Impl {
   static constexpr int kConstantCacheBits = 10;
   /// Direct-mapped cache of recent constants, indexed by a hash of the value's bits.
   std::vector<ConstantSlot> recentConstants = std::vector<ConstantSlot>(size_t{1} << kConstantCacheBits);
-  std::vector<std::string_view> symbolNames;  ///< by symbolId; the characters are in nameChars
+  ChunkedVector<std::string_view> symbolNames;  ///< by symbolId; the characters are in nameChars
   Arena nameChars;                            ///< every symbol's name (stable: views stay valid)
-  std::vector<Expr> symbols;                  ///< by symbolId
+  ChunkedVector<Expr> symbols;                ///< by symbolId
   /// The symbols symbolArray made, one block per array: `prefix[i,j]suffix`, row-major over
   /// `shape`, with consecutive ids from `first`. They are not in the name table: a name is found
   /// in its block by its family (prefix and suffix) and its subscripts.
@@ -144,6 +166,7 @@ struct Context::Impl {
     std::vector<int> shape;
   };
   std::vector<SymbolBlock> blocks;                      ///< in order of `first`
+  size_t inBlocks = 0;                                   ///< symbols in blocks
   std::unordered_map<uint64_t, uint32_t> blockByFamily;  ///< family hash -> index in blocks
   /// A Bloom filter of the families of the subscripted names in the name table: an array whose
   /// family may be among them is made name by name, through the table (so a name has one symbol).
