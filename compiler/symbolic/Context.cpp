@@ -264,6 +264,7 @@ Expr Context::Impl::symbol(std::string_view name, uint64_t hash) {
     if (Expr s = findInBlocks(name)) return s;
   if (auto parts = splitSubscripts(name)) {
     uint64_t family = familyHash(parts->prefix, parts->suffix);
+    if (tableFamilies.empty()) tableFamilies.resize(kFamilyBits / 64);
     tableFamilies[family % kFamilyBits / 64] |= uint64_t{1} << (family % 64);
   }
   Expr s = newSymbol(name);
@@ -294,7 +295,7 @@ const Context::Impl::SymbolBlock* Context::Impl::blockOf(uint32_t id) const {
 
 std::string_view Context::Impl::storeName(std::string_view name) {
   if (name.empty()) return {};
-  char* chars = nameChars.allocate<char>(name.size());
+  char* chars = arena.allocate<char>(name.size());
   std::memcpy(chars, name.data(), name.size());
   return {chars, name.size()};
 }

@@ -126,7 +126,7 @@ class ChunkedVector {
   }
 
  private:
-  static constexpr size_t kBits = 16, kChunk = size_t{1} << kBits, kMask = kChunk - 1;
+  static constexpr size_t kBits = 12, kChunk = size_t{1} << kBits, kMask = kChunk - 1;
   std::vector<std::unique_ptr<T[]>> chunks_;
   size_t size_ = 0;
 };
@@ -153,8 +153,7 @@ struct Context::Impl {
   static constexpr int kConstantCacheBits = 10;
   /// Direct-mapped cache of recent constants, indexed by a hash of the value's bits.
   std::vector<ConstantSlot> recentConstants = std::vector<ConstantSlot>(size_t{1} << kConstantCacheBits);
-  ChunkedVector<std::string_view> symbolNames;  ///< by symbolId; the characters are in nameChars
-  Arena nameChars;                            ///< every symbol's name (stable: views stay valid)
+  ChunkedVector<std::string_view> symbolNames;  ///< by symbolId; the characters are in the arena
   ChunkedVector<Expr> symbols;                ///< by symbolId
   /// The symbols symbolArray made, one block per array: `prefix[i,j]suffix`, row-major over
   /// `shape`, with consecutive ids from `first`. They are not in the name table: a name is found
@@ -171,7 +170,7 @@ struct Context::Impl {
   /// A Bloom filter of the families of the subscripted names in the name table: an array whose
   /// family may be among them is made name by name, through the table (so a name has one symbol).
   static constexpr size_t kFamilyBits = size_t{1} << 16;
-  std::vector<uint64_t> tableFamilies = std::vector<uint64_t>(kFamilyBits / 64);
+  std::vector<uint64_t> tableFamilies;  ///< kFamilyBits bits once a subscripted name is made
   struct NameSlot {  // trivial, like TableSlot: a large table asks for huge pages before it is touched
     uint32_t tag;    ///< low half of the name's hash (all the table's position needs)
     uint32_t entry;  ///< symbolId + 1; 0 = empty
@@ -205,9 +204,10 @@ struct Context::Impl {
   const SymbolBlock* blockOf(uint32_t id) const;
   /// Whether symbolArray may make this family as a block (no name of it can exist yet).
   bool familyFree(uint64_t family) const {
-    return !(tableFamilies[family % kFamilyBits / 64] >> (family % 64) & 1) && !blockByFamily.contains(family);
+    bool maybeInTable = !tableFamilies.empty() && (tableFamilies[family % kFamilyBits / 64] >> (family % 64) & 1);
+    return !maybeInTable && !blockByFamily.contains(family);
   }
-  /// A copy of the name in nameChars.
+  /// A copy of the name in the arena.
   std::string_view storeName(std::string_view name);
   /// Room for `symbols` more symbols and `nodes` more interned nodes without rehashing.
   void reserve(size_t symbols, size_t nodes);
