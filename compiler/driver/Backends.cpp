@@ -112,7 +112,12 @@ void printTieringDecision(const RunnableModel& m, const rt::TierReport& tiers, s
       << e.plainInstructions << " at level 0, " << e.units << " modules) is estimated at " << e.cpuSeconds * 1e3
       << " ms of CPU on " << e.threads << " thread(s)\n";
   TierVerdict v = decideTiering(seen, e.cpuSeconds);
-  if (tiers.started) {
+  if (tiers.started && v.oneCallPays) {
+    log << "tiering: compile started " << seen.elapsedSeconds * 1e3 << " ms into the run, at " << seen.progress * 100
+        << " % of the horizon: the VM had spent " << seen.firstTierSeconds * 1e3 << " ms in " << seen.firstTierCalls
+        << " residual/Jacobian calls; native code saves ~" << v.savingSeconds * 1e3
+        << " ms of each, more than the whole compile\n";
+  } else if (tiers.started) {
     log << "tiering: compile started " << seen.elapsedSeconds * 1e3 << " ms into the run, at " << seen.progress * 100
         << " % of the horizon: the VM had spent " << seen.firstTierSeconds * 1e3 << " ms in " << seen.firstTierCalls
         << " residual/Jacobian calls, projecting " << v.remainingVmSeconds * 1e3 << " ms more, of which native code saves ~"

@@ -49,6 +49,8 @@ struct TierVerdict {
   bool compile = false;
   double remainingVmSeconds = 0;  ///< VM time in residual and Jacobian calls still to come
   double savingSeconds = 0;       ///< what native code would save of it, after the compile
+  /// Decided on one call's cost: native code saves more of a single call than the compile takes.
+  bool oneCallPays = false;
 };
 
 /// The decision on what the run has shown so far (`seen`), for a compile of `compileSeconds`.

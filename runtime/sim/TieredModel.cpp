@@ -14,8 +14,11 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// First-tier calls between two questions to the trigger (a few floating-point operations).
+// First-tier calls between two questions to the trigger (a few floating-point operations), unless
+// the calls take kAskEachCallAbove or more on average (a large model's): then after every call,
+// since a question costs nothing beside them and each call waited for is a call not on native code.
 constexpr uint64_t kAskEvery = 8;
+constexpr double kAskEachCallAbove = 1e-3;
 // Calls of at least kLongCall are all timed; shorter ones one in kSparse, counting kSparse times:
 // reading the clock twice costs about as much as a call of the smallest models, which the solver
 // may make millions of.
@@ -92,9 +95,12 @@ struct Tiered : QdotModel {
     });
   }
 
-  // Asks the trigger every kAskEvery first-tier calls until it starts the compile.
+  // Asks the trigger every kAskEvery first-tier calls (every call, if they are long) until it
+  // starts the compile.
   void consider() {
-    if (started || firstCalls < nextQuestion) return;
+    if (started) return;
+    bool longCalls = firstCalls > 0 && firstSeconds >= kAskEachCallAbove * double(firstCalls);
+    if (firstCalls < nextQuestion && !longCalls) return;
     nextQuestion = firstCalls + kAskEvery;
     look = observe();
     if (trigger(look)) return startCompile();

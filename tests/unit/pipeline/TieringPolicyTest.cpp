@@ -60,6 +60,30 @@ TEST(TieringPolicy, DecidesOnlyOnceItHasSeenEnough) {
   EXPECT_FALSE(decideTiering(steadyRun(0, 0.5, 0.4), 0.05, eager).compile);
 }
 
+// A very large model on the VM: a residual or Jacobian call would save more on native code than
+// the whole compile takes (the chain of 10⁶ masses: 57 ms a call against ~25 ms of JIT), so the
+// compile starts after the first calls, before the solver's tiny first steps show any progress.
+// Cheaper calls wait for the progress, and a run that is over never compiles.
+TEST(TieringPolicy, ACallDearerThanTheCompileCompilesAtOnce) {
+  rt::TierObservation firstCalls;
+  firstCalls.elapsedSeconds = 0.2;
+  firstCalls.firstTierSeconds = 0.15;
+  firstCalls.firstTierCalls = 3;  // 50 ms each; no progress yet
+  TierVerdict v = decideTiering(firstCalls, 0.025);
+  EXPECT_TRUE(v.compile);
+  EXPECT_TRUE(v.oneCallPays);
+  EXPECT_NEAR(v.savingSeconds, 0.05 * 0.75, 1e-12);  // a call, at the rule's native speed-up of 4
+  EXPECT_TRUE(decideTiering(firstCalls, 0.037).compile);   // 37.5 ms saved a call >= 37 ms
+  EXPECT_FALSE(decideTiering(firstCalls, 0.038).compile);  // < 38 ms: wait for progress
+  EXPECT_FALSE(decideTiering(firstCalls, 0.025, {.nativeSpeedup = 4, .payback = 2, .minObserved = 10}).compile);  // seen too little
+  rt::TierObservation cheap = firstCalls;
+  cheap.firstTierSeconds = 0.003;  // 1 ms a call
+  EXPECT_FALSE(decideTiering(cheap, 0.025).compile);
+  rt::TierObservation over = firstCalls;
+  over.progress = 1;
+  EXPECT_FALSE(decideTiering(over, 0.025).compile);
+}
+
 TEST(TieringPolicy, TheRecentRateCountsNotTheRateSinceTheStart) {
   // 10 % of the horizon; the first 8 % took 90 ms of VM time in short steps, the last 2 % 10 ms:
   // 90 % to go at the recent rate is 0.45 s, not the 0.9 s the average would give.
