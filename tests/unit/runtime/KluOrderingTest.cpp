@@ -321,6 +321,26 @@ TEST(KluBandOrdering, ASessionSolvesAScrambledChainInItsBand) {
   EXPECT_LT(worst, 100 * rtol);
 }
 
+// The same above 20 000 unknowns, where the session orders the pattern on another thread while it
+// computes the start values (IdaSession's orderAhead): the same band, the same accuracy.
+TEST(KluBandOrdering, ALargeSessionOrdersItsChainAhead) {
+  const int n = 25000;
+  const double rtol = 1e-7, h = 1.0 / (n + 1);
+  const double lambda = 4.0 / (h * h) * std::pow(std::sin(std::numbers::pi * h / 2), 2);
+  std::vector<int64_t> at = scramble(n, 5);
+  std::vector<int> cellOf(n);
+  for (int i = 0; i < n; ++i) cellOf[at[i]] = i;
+  HandModel model = scrambledHeatChain(n, at);
+  SimulationResult r;
+  double worst = worstErrorOnKlu(model, n, 0.02, 0.01, rtol, [&](double t, int v) {
+    return std::exp(-lambda * t) * std::sin(std::numbers::pi * (cellOf[v] + 1) * h);
+  }, r);
+  ASSERT_TRUE(r.bandwidth);
+  EXPECT_EQ(*r.bandwidth, 1);
+  EXPECT_FALSE(r.blockTriangular);
+  EXPECT_LT(worst, 100 * rtol);
+}
+
 /// Heat conduction on an m × m grid of cells (5-point Laplacian, zero at the border), started in
 /// its lowest eigenmode sin(πih) sin(πjh): it decays as exp(−2λt), λ = 4/h² sin²(πh/2).
 HandModel heatGrid(int m) {
