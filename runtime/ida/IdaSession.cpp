@@ -102,6 +102,7 @@ struct IdaSession::Impl {
   std::vector<sunindextype> columnStarts, rowIndices;  // the CSC pattern in SUNDIALS' index type
   std::vector<double> jacobianValues;                  // dense only: values before scattering
   ToleranceVector tolerances;
+  std::vector<double> tolerancesY;  ///< the y that `tolerances` were built from (applyTolerances)
   TimeScale timeScale;  ///< the velocities' time scale, from the linearization at the start
   double t;
   double tout = 0;
@@ -134,10 +135,10 @@ struct IdaSession::Impl {
   void createIntegrator();
   void attachLinearSolver();
   void orderAhead();
-  void applyTolerances(bool calibrated = true);
+  void applyTolerances(bool calibrated = true, bool sameY = false);
   void initialize(double tout1);
   void calculateConsistentValues(double tout1);
-  void restartFromConsistentValues();
+  void restartFromConsistentValues(bool sameY = false);
   void estimateAlgebraicRates(double tout1);
   /// ∂F/∂y and J(cj = 1) at the start, in the Jacobian's CSC order (empty if J cannot be evaluated).
   struct StartJacobians {
@@ -403,10 +404,17 @@ void IdaSession::Impl::createIntegrator() {
 // calibrated = false: the tolerances as the user gave them, for IDACalcIC, whose Newton test is
 // relative to them (tighter weights made the line search fail on constrained models); the run
 // itself uses the calibrated ones (Tolerances.h).
-void IdaSession::Impl::applyTolerances(bool calibrated) {
-  tolerances = buildTolerances(options.rtol, options.atol, {data(y), n}, nominal, {model.isDifferential, n}, start,
-                               timeScale);
-  if (!calibrated) useAsGiven(tolerances);
+// sameY: y, the start values and the nominals are those of the last build (only y' changed, as
+// after the diagonal rates): the scales are kept (useCalibrated) instead of computed again.
+void IdaSession::Impl::applyTolerances(bool calibrated, bool sameY) {
+  if (sameY && calibrated && tolerances.scale.size() == n && std::equal(tolerancesY.begin(), tolerancesY.end(), data(y))) {
+    useCalibrated(tolerances);
+  } else {
+    tolerances = buildTolerances(options.rtol, options.atol, {data(y), n}, nominal, {model.isDifferential, n}, start,
+                                 timeScale);
+    tolerancesY.assign(data(y), data(y) + n);
+    if (!calibrated) useAsGiven(tolerances);
+  }
   std::copy(tolerances.atol.begin(), tolerances.atol.end(), data(atol));
   check(IDASVtolerances(ida, tolerances.solverRtol, atol), "IDASVtolerances");
 }
@@ -661,10 +669,11 @@ void IdaSession::Impl::initialize(double tout1) {
   bool hasAlgebraic = std::any_of(model.isDifferential, model.isDifferential + n, [](int32_t d) { return d == 0; });
   if (!hasAlgebraic) {
     std::vector<double> F = startResidual();
-    if (consistent(F)) return applyTolerances();
+    // y is as createIntegrator built the tolerances from: only y' may change here
+    if (consistent(F)) return applyTolerances(true, true);
     if (!dummies && solveDiagonalRates(start, std::move(F), tout1)) {
       initialValues = InitialValueMethod::DiagonalRates;
-      return restartFromConsistentValues();
+      return restartFromConsistentValues(true);
     }
   }
   start = {};
@@ -684,9 +693,9 @@ void IdaSession::Impl::initialize(double tout1) {
 
 // Automatic scales from the consistent values. IDA binds its tolerance data during its initial
 // setup (which IDACalcIC has done), so new tolerances need a restart from the consistent point.
-void IdaSession::Impl::restartFromConsistentValues() {
+void IdaSession::Impl::restartFromConsistentValues(bool sameY) {
   check(IDAReInit(ida, options.t0, y, yp), "IDAReInit");
-  applyTolerances();
+  applyTolerances(true, sameY);
   if (yStep) {
     N_VScale(1.0, y, yStep);
     N_VScale(1.0, yp, ypStep);

@@ -117,29 +117,40 @@ ToleranceVector buildTolerances(double rtol, std::optional<double> atol, std::sp
     if (result.summary.velocities > 0) result.summary.frequency = timeScale.frequency;
   }
   result.solverRtol = atol ? rtol : calibratedRtol(rtol);
-  double base = atol.value_or(result.solverRtol);  // automatic: the calibrated rtol, relative and absolute alike
-  result.atol.reserve(result.scale.size());
-  for (double scale : result.scale) {
-    double value = base * scale;
-    // Guard against overflow or underflow of the product: IDA rejects a zero or infinite weight.
-    if (!std::isfinite(value) || value <= 0) value = base;
-    result.atol.push_back(value);
-  }
   ToleranceSummary& s = result.summary;
   s.rtol = rtol;
-  s.solverRtol = result.solverRtol;
-  s.atolUser = base;
   s.atolGiven = atol.has_value();
-  s.count = result.atol.size();
   s.automatic =
       static_cast<std::size_t>(std::count_if(nominal.begin(), nominal.end(), [](double v) { return !hasNominal(v); }));
-  if (!result.atol.empty()) {
-    auto [lo, hi] = std::minmax_element(result.atol.begin(), result.atol.end());
+  fillAtol(result, atol.value_or(result.solverRtol));  // automatic: the calibrated rtol, relative and absolute alike
+  return result;
+}
+
+// atol_i = base * scale_i and the summary's figures of it.
+void fillAtol(ToleranceVector& t, double base) {
+  t.atol.resize(t.scale.size());
+  for (std::size_t i = 0; i < t.scale.size(); ++i) {
+    double value = base * t.scale[i];
+    // Guard against overflow or underflow of the product: IDA rejects a zero or infinite weight.
+    if (!std::isfinite(value) || value <= 0) value = base;
+    t.atol[i] = value;
+  }
+  ToleranceSummary& s = t.summary;
+  s.solverRtol = t.solverRtol;
+  s.atolUser = base;
+  s.count = t.atol.size();
+  if (!t.atol.empty()) {
+    auto [lo, hi] = std::minmax_element(t.atol.begin(), t.atol.end());
     s.atolMin = *lo;
     s.atolMax = *hi;
-    s.atolMedian = median(result.atol);
+    s.atolMedian = median(t.atol);
   }
-  return result;
+}
+
+void useCalibrated(ToleranceVector& t) {
+  if (t.summary.atolGiven) return;  // as built: solverRtol = rtol, atol the user's
+  t.solverRtol = calibratedRtol(t.summary.rtol);
+  fillAtol(t, t.solverRtol);
 }
 
 void useAsGiven(ToleranceVector& t) {

@@ -101,6 +101,16 @@ ToleranceVector buildTolerances(double rtol, std::optional<double> atol, std::sp
 /// tolerances, and ARKODE (the calibration is measured for IDA's BDF only).
 void useAsGiven(ToleranceVector& tolerances);
 
+/// What buildTolerances gives for the same scales (y, start values and nominals unchanged), from
+/// tolerances made so or changed by useAsGiven: solverRtol = calibratedRtol(rtol), the automatic
+/// atol_i = solverRtol * scale_i computed as buildTolerances computes them, the summary to match;
+/// no-op with --atol. Spares computing the scales again (at 2·10⁶ unknowns, 0.05 s).
+void useCalibrated(ToleranceVector& tolerances);
+
+/// atol_i = base * scale_i (base where the product is not a positive finite number) and the
+/// summary's solverRtol, atolUser, count, minimum, median and maximum of them.
+void fillAtol(ToleranceVector& tolerances, double base);
+
 /// Recalibrates automatic tolerances for another method (no-op with --atol): solverRtol =
 /// calibratedRtol(rtol, calibration), the automatic atol_i = solverRtol * scale_i, the summary to match.
 void useCalibration(ToleranceVector& tolerances, const RtolCalibration& calibration);

@@ -61,6 +61,34 @@ TEST(ToleranceVector, AutomaticAtolIsRtolTimesScale) {
 
 }
 
+// useCalibrated brings tolerances made as given (for IDACalcIC) back to what a calibrated build
+// from the same y gives, bit for bit, without computing the scales again; with --atol it changes
+// nothing. (The session uses it when only y' changed since the build.)
+TEST(ToleranceVector, UseCalibratedEqualsACalibratedBuild) {
+  std::vector<double> y0 = {1e-8, 3, 0, -0.7, 1e300};
+  std::vector<double> nominal = {0, 0, 2, 0, 0};
+  std::vector<int32_t> kind = {1, 1, 1, 0, 0};
+  for (double rtol : {1e-3, 1e-6, 1e-9}) {
+    ToleranceVector calibrated = buildTolerances(rtol, std::nullopt, y0, nominal, kind);
+    ToleranceVector v = buildTolerances(rtol, std::nullopt, y0, nominal, kind);
+    useAsGiven(v);
+    EXPECT_EQ(v.solverRtol, rtol);
+    useCalibrated(v);
+    EXPECT_EQ(v.solverRtol, calibrated.solverRtol);
+    EXPECT_EQ(v.atol, calibrated.atol);  // exactly
+    EXPECT_EQ(v.summary.atolMin, calibrated.summary.atolMin);
+    EXPECT_EQ(v.summary.atolMedian, calibrated.summary.atolMedian);
+    EXPECT_EQ(v.summary.atolMax, calibrated.summary.atolMax);
+    EXPECT_EQ(v.summary.atolUser, calibrated.summary.atolUser);
+    EXPECT_EQ(v.summary.automatic, calibrated.summary.automatic);
+  }
+  ToleranceVector given = buildTolerances(1e-6, 1e-9, y0, nominal, kind);
+  std::vector<double> before = given.atol;
+  useCalibrated(given);
+  EXPECT_EQ(given.atol, before);
+  EXPECT_EQ(given.solverRtol, 1e-6);
+}
+
 // A given atol is absolute in each variable's units (SUNDIALS, SciPy): the start values do not
 // scale it; only a nominal does.
 TEST(ToleranceVector, GivenAtolIsAbsoluteExceptTimesNominal) {
