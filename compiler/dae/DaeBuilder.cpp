@@ -270,11 +270,9 @@ class Builder {
       buffer.clear(), ends.clear();
     };
     for (size_t k = 0; k < coordinates.size();) {
-      if (size_t count = wholeArrayAt(coordinates, k)) {
+      if (size_t count = ctx_.wholeSymbolArrayAt(std::span(coordinates).subspan(k))) {
         make();
-        auto array = ctx_.symbolArrayOf(coordinates[k]);
-        std::vector<int> shape(array->shape.begin(), array->shape.end());
-        for (Expr s : ctx_.symbolArray("$der(" + std::string(array->prefix), shape, std::string(array->suffix) + ")")) rates.push_back(s);
+        for (Expr s : ctx_.symbolArrayAround(coordinates[k], "$der(", ")")) rates.push_back(s);
         k += count;
         continue;
       }
@@ -284,18 +282,6 @@ class Builder {
     }
     make();
     return rates;
-  }
-
-  // The number of symbols from symbols[k] on that are a whole array of symbols in order, or 0.
-  size_t wholeArrayAt(const std::vector<Expr>& symbols, size_t k) const {
-    auto array = ctx_.symbolArrayOf(symbols[k]);
-    if (!array || array->first != symbols[k]->symbolId) return 0;
-    size_t count = 1;
-    for (int n : array->shape) count *= static_cast<size_t>(n);
-    if (k + count > symbols.size()) return 0;
-    for (size_t j = 0; j < count; ++j)
-      if (symbols[k + j]->symbolId != array->first + j) return 0;
-    return count;
   }
 
   // The kinematic rows q' - der(q) that no template took (templated models only).

@@ -242,20 +242,12 @@ void Flattener::addCoordinateDerivatives(const Value& coordinates) {
 // The coordinates are a whole array of symbols (Context::symbolArray), none with a velocity yet:
 // their velocities and accelerations are two such arrays, der(x[i]) and der(der(x[i])).
 bool Flattener::addCoordinateDerivativeArrays(const Value& coordinates) {
-  if (coordinates.elems.empty()) return false;
-  auto array = ctx_.symbolArrayOf(coordinates.elems[0]);
-  if (!array || array->first != coordinates.elems[0]->symbolId) return false;
-  size_t count = 1;
-  for (int n : array->shape) count *= static_cast<size_t>(n);
-  if (count != coordinates.elems.size()) return false;
-  for (size_t k = 0; k < count; ++k) {
-    Expr x = coordinates.elems[k];
-    if (x->symbolId != array->first + k || out_.variables[out_.variableOf(x)].derivative >= 0) return false;
-  }
-  std::string prefix(array->prefix), suffix(array->suffix);
-  std::vector<int> shape(array->shape.begin(), array->shape.end());
-  std::vector<Expr> velocities = ctx_.symbolArray("der(" + prefix, shape, suffix + ")");
-  std::vector<Expr> accelerations = ctx_.symbolArray("der(der(" + prefix, shape, suffix + "))");
+  size_t count = ctx_.wholeSymbolArrayAt(coordinates.elems);
+  if (count == 0 || count != coordinates.elems.size()) return false;
+  for (Expr x : coordinates.elems)
+    if (out_.variables[out_.variableOf(x)].derivative >= 0) return false;
+  std::vector<Expr> velocities = ctx_.symbolArrayAround(coordinates.elems[0], "der(", ")");
+  std::vector<Expr> accelerations = ctx_.symbolArrayAround(coordinates.elems[0], "der(der(", "))");
   for (size_t k = 0; k < count; ++k) {
     int var = out_.variableOf(coordinates.elems[k]);
     addDerivative(addDerivative(var, VarRole::Velocity, velocities[k]), VarRole::Acceleration, accelerations[k]);

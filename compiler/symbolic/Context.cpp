@@ -367,6 +367,29 @@ std::optional<Context::SymbolArrayInfo> Context::symbolArrayOf(Expr s) const {
   return SymbolArrayInfo{b->prefix, b->suffix, b->shape, b->first};
 }
 
+size_t Context::wholeSymbolArrayAt(std::span<const Expr> symbols) const {
+  if (symbols.empty()) return 0;
+  auto array = symbolArrayOf(symbols[0]);
+  if (!array || array->first != symbols[0]->symbolId) return 0;
+  size_t count = 1;
+  for (int n : array->shape) count *= static_cast<size_t>(n);
+  if (count > symbols.size()) return 0;
+  for (size_t j = 0; j < count; ++j)
+    if (!symbols[j]->isSymbol() || symbols[j]->symbolId != array->first + j) return 0;
+  return count;
+}
+
+std::vector<Expr> Context::symbolArrayAround(Expr first, std::string_view before, std::string_view after) {
+  auto array = symbolArrayOf(first);
+  if (!array || array->first != first->symbolId)
+    throw std::logic_error("symbolArrayAround: not the first element of a symbol array");
+  // Copies first: making the new block may move the strings and shapes the views point into.
+  std::string prefix = std::string(before) + std::string(array->prefix);
+  std::string suffix = std::string(array->suffix) + std::string(after);
+  std::vector<int> shape(array->shape.begin(), array->shape.end());
+  return symbolArray(prefix, shape, suffix);
+}
+
 // Linear probing; a slot whose tag differs cannot hold the name, so most misses compare no string.
 Context::Impl::NameSlot& Context::Impl::nameSlot(std::string_view name, uint64_t hash) {
   size_t mask = nameTableSize - 1;

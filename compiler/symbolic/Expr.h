@@ -130,6 +130,12 @@ class Context {
     uint32_t first = 0;
   };
   std::optional<SymbolArrayInfo> symbolArrayOf(Expr s) const;
+  /// How many of `symbols`, from the first on, are one whole symbolArray in order (its first
+  /// element first): the array's size, or 0 if they are not.
+  size_t wholeSymbolArrayAt(std::span<const Expr> symbols) const;
+  /// For the array whose first element is `first`: the array of the same shape named
+  /// `before` + element's name + `after` (der(x[i]) for x[i]), made as one block too.
+  std::vector<Expr> symbolArrayAround(Expr first, std::string_view before, std::string_view after);
   std::string_view symbolName(Expr s) const;
   size_t symbolCount() const;
 

@@ -267,3 +267,34 @@ TEST(Storage, SymbolArraysAreFoundByName) {
   // An empty array has no symbols.
   EXPECT_TRUE(ctx.symbolArray("e", std::vector<int>{0}).empty());
 }
+
+// wholeSymbolArrayAt recognises an array's symbols only whole and in order, and symbolArrayAround
+// makes the array of the names around them (der(q[i]) for q[i]) as a block of the same shape.
+TEST(Storage, ASymbolArrayIsRecognisedWholeAndWrapped) {
+  Context ctx;
+  std::vector<int> shape{2, 2};
+  std::vector<Expr> q = ctx.symbolArray("q", shape);
+  Expr other = ctx.symbol("b");
+  EXPECT_EQ(ctx.wholeSymbolArrayAt(q), 4u);
+  std::vector<Expr> longer = q;
+  longer.push_back(other);
+  EXPECT_EQ(ctx.wholeSymbolArrayAt(longer), 4u);
+  EXPECT_EQ(ctx.wholeSymbolArrayAt(std::span(q).subspan(1)), 0u);  // not from its first element
+  EXPECT_EQ(ctx.wholeSymbolArrayAt(std::span(q).first(3)), 0u);    // not whole
+  std::vector<Expr> swapped{q[0], q[2], q[1], q[3]};
+  EXPECT_EQ(ctx.wholeSymbolArrayAt(swapped), 0u);                  // not in order
+  std::vector<Expr> notSymbols{ctx.add(q[0], other), q[1], q[2], q[3]};
+  EXPECT_EQ(ctx.wholeSymbolArrayAt(notSymbols), 0u);
+  EXPECT_EQ(ctx.wholeSymbolArrayAt({}), 0u);
+  EXPECT_EQ(ctx.wholeSymbolArrayAt(std::vector<Expr>{other}), 0u);
+
+  std::vector<Expr> rates = ctx.symbolArrayAround(q[0], "der(", ")");
+  ASSERT_EQ(rates.size(), 4u);
+  EXPECT_EQ(ctx.symbolName(rates[3]), "der(q[2,2])");
+  EXPECT_EQ(ctx.findSymbol("der(q[1,2])"), rates[1]);
+  EXPECT_EQ(ctx.wholeSymbolArrayAt(rates), 4u);
+  std::vector<Expr> twice = ctx.symbolArrayAround(rates[0], "der(", ")");
+  EXPECT_EQ(ctx.symbolName(twice[2]), "der(der(q[2,1]))");
+  EXPECT_THROW(ctx.symbolArrayAround(q[1], "der(", ")"), std::logic_error);
+  EXPECT_THROW(ctx.symbolArrayAround(other, "der(", ")"), std::logic_error);
+}
