@@ -31,6 +31,7 @@ class Builder {
     dae_.structuralParameters = m_.structuralParameters;
     dae_.unconnected = m_.unconnected;
     dae_.outputs = m_.outputs;
+    sortVariablesByRole();
     if (!m_.equationTemplates.empty()) {  // an explicit ODE (isTemplatedOde): balanced by construction
       addParameters();
       addTemplatedOde(m_, ctx_, dae_);
@@ -90,11 +91,29 @@ class Builder {
   std::vector<Expr> aliasTable_;            ///< the same by symbol id (null: no alias), for substituting
   uint64_t aliasMask_ = 0;
   std::vector<char> appears_;               ///< by symbol id: in some equation (after substitution)
+  /// The flat variables the steps below visit, found in one pass: a large model has three per
+  /// array element (x, der(x), der(der(x))), and a pass over them costs more than the steps' work.
+  struct VariablesByRole {
+    std::vector<int> aliased;     ///< with an alias, any role
+    std::vector<int> parameters;  ///< in declaration order
+    std::vector<int> unknowns;    ///< role Unknown and no alias, in declaration order
+    size_t unknownRole = 0;       ///< role Unknown, aliased or not
+  } byRole_;
+
+  void sortVariablesByRole() {
+    for (int i = 0; i < static_cast<int>(m_.variables.size()); ++i) {
+      const flat::Variable& f = m_.variables[i];
+      if (f.alias) byRole_.aliased.push_back(i);
+      if (f.role == flat::VarRole::Parameter) byRole_.parameters.push_back(i);
+      if (f.role != flat::VarRole::Unknown) continue;
+      ++byRole_.unknownRole;
+      if (!f.alias) byRole_.unknowns.push_back(i);
+    }
+  }
 
   // Connected potentials and their derivatives are one variable (FlatModel: Variable::alias).
   void collectAliases() {
-    for (const auto& v : m_.variables)
-      if (v.alias) aliases_.emplace(v.symbol, v.alias);
+    for (int i : byRole_.aliased) aliases_.emplace(m_.variables[i].symbol, m_.variables[i].alias);
     // An alias of an alias (a value that is itself eliminated) resolves to the end of the chain.
     aliasMask_ = sym::Context::keyMaskOf(aliases_);
     for (auto& [from, to] : aliases_)
@@ -129,9 +148,7 @@ class Builder {
 
   // At most: a coordinate and its velocity per row, every other unknown, every multiplier.
   size_t unknownCount() const {
-    size_t n = 2 * eom_.rows.size() + eom_.multipliers.size();
-    for (const auto& f : m_.variables) n += f.role == flat::VarRole::Unknown;
-    return n;
+    return 2 * eom_.rows.size() + eom_.multipliers.size() + byRole_.unknownRole;
   }
 
   Variable fromFlat(int index, VarKind kind, UnknownRole role) {
@@ -141,11 +158,11 @@ class Builder {
   }
 
   void addParameters() {
-    for (const auto& f : m_.variables)
-      if (f.role == flat::VarRole::Parameter)
-        dae_.parameters.push_back(
-            {std::string(f.name), f.symbol, f.value, std::string(m_.attributesOf(f).description),
-             std::string(m_.attributesOf(f).unit), f.declRange, f.input});
+    for (int i : byRole_.parameters) {
+      const flat::Variable& f = m_.variables[i];
+      dae_.parameters.push_back({std::string(f.name), f.symbol, f.value, std::string(m_.attributesOf(f).description),
+                                 std::string(m_.attributesOf(f).unit), f.declRange, f.input});
+    }
   }
 
   // Coordinates first, then velocities (spec §5). A coordinate whose row contains no velocity at
@@ -295,9 +312,8 @@ class Builder {
 
   void addUnknowns() {
     std::vector<Variable> algebraic;
-    for (int i = 0; i < static_cast<int>(m_.variables.size()); ++i) {
+    for (int i : byRole_.unknowns) {
       const flat::Variable& f = m_.variables[i];
-      if (f.role != flat::VarRole::Unknown || f.alias) continue;
       if (f.derivative >= 0) {
         Variable v = fromFlat(i, VarKind::State, UnknownRole::State);
         v.yp = m_.variables[f.derivative].symbol;

@@ -96,8 +96,9 @@ class Deriver {
     lagrangian_.finish(m_.variables.size());
     dissipation_.finish(m_.variables.size());
     makeMultipliers();
+    coordinates_ = m_.variablesWithRole(VarRole::Coordinate);  // one pass: a large model has 3 variables per element
     if (templates) deriveTemplates();
-    for (int q : m_.variablesWithRole(VarRole::Coordinate)) derive(q);
+    for (int q : coordinates_) derive(q);
     if (diags_.errorCount() > errorsBefore) return std::nullopt;
     findFirstIntegrals();
     out_.kinetic = simplified(total(m_.kinetic));
@@ -299,12 +300,13 @@ class Deriver {
     }
   }
   std::vector<int> scalarSums_;
+  std::vector<int> coordinates_;  ///< the flat variables of role Coordinate, in order
   std::vector<std::pair<int, Expr>> scalarForces_;  ///< force templates made scalar: (coordinate, force)
 
   // Coordinates that occur in scalar terms, forces or constraints keep scalar rows (peeled).
   std::vector<char> peeledCoordinates() const {
     std::vector<char> peeled(m_.variables.size(), 0);
-    for (int q : m_.variablesWithRole(VarRole::Coordinate)) {
+    for (int q : coordinates_) {
       int v = m_.variables[q].derivative;
       peeled[q] = !lagrangian_.termsOf(q).empty() || !lagrangian_.termsOf(v).empty() || !dissipation_.termsOf(v).empty() ||
                   !forcesOn(q).empty() || !m_.constraints.empty() || m_.variables[q].alias;
