@@ -71,6 +71,54 @@ void computeDerived(NodeKey& n) {
   n.depth = std::min(depth, Node::kMaxDepth);
 }
 
+// What computeDerived gives a symbol's node, without a NodeKey (symbolArray makes millions).
+uint64_t symbolHash(uint32_t id) { return mix(mix(static_cast<uint64_t>(Kind::Symbol) + 1, id), numberBits(0.0)); }
+
+// The names prefix[i,j,…]suffix of a shape's points in row-major order, advanced in place: the
+// last subscript's digits count up as text, and the whole name is written again only when that
+// subscript wraps or gains a digit (a few times per array).
+class SubscriptedNames {
+ public:
+  SubscriptedNames(std::string_view prefix, std::span<const int> shape, std::string_view suffix)
+      : prefix_(prefix), suffix_(suffix), shape_(shape), index_(shape.size(), 1) {
+    write();
+  }
+  std::string_view current() const { return name_; }
+  void advance() {
+    if (index_.empty()) return;
+    size_t d = index_.size() - 1;
+    if (++index_[d] <= shape_[d] && countUpLastDigits()) return;
+    while (index_[d] > shape_[d] && d > 0) index_[d] = 1, ++index_[--d];
+    write();
+  }
+
+ private:
+  bool countUpLastDigits() {
+    for (size_t i = lastDigitsEnd_; i-- > lastDigitsBegin_;) {
+      if (name_[i] != '9') return ++name_[i], true;
+      name_[i] = '0';
+    }
+    return false;  // 99… → 100…: one digit more
+  }
+  void write() {
+    name_.assign(prefix_);
+    char digits[16];
+    for (size_t d = 0; d < index_.size(); ++d) {
+      name_ += d ? ',' : '[';
+      lastDigitsBegin_ = name_.size();
+      name_.append(digits, std::to_chars(digits, digits + sizeof digits, index_[d]).ptr);
+    }
+    lastDigitsEnd_ = name_.size();
+    name_ += ']';
+    name_ += suffix_;
+  }
+  std::string_view prefix_, suffix_;
+  std::span<const int> shape_;
+  std::vector<int> index_;
+  std::string name_;
+  size_t lastDigitsBegin_ = 0, lastDigitsEnd_ = 0;
+};
+
 template <class T>
 bool sameElements(std::span<const T> a, std::span<const T> b) {
   return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
@@ -313,29 +361,15 @@ Expr Context::findSymbol(std::string_view name) const {
 std::vector<Expr> Context::symbolArray(std::string_view prefix, std::span<const int> shape, std::string_view suffix) {
   size_t count = 1;
   for (int n : shape) count *= n > 0 ? static_cast<size_t>(n) : 0;
+  if (count == 0) return {};
   uint64_t family = familyHash(prefix, suffix);
-  bool asBlock = !shape.empty() && count > 0 && suffix.find_first_of("[]") == std::string_view::npos &&
+  bool asBlock = !shape.empty() && suffix.find_first_of("[]") == std::string_view::npos &&
                  impl_->symbols.size() + count < UINT32_MAX && impl_->familyFree(family);
-  std::string name(prefix);
-  std::vector<int> index(shape.size(), 1);
-  char digits[16];
-  auto formatName = [&] {  // prefix[index]suffix, then index advances row-major
-    name.resize(prefix.size());
-    for (size_t d = 0; d < index.size(); ++d) {
-      name += d ? ',' : '[';
-      name.append(digits, std::to_chars(digits, digits + sizeof digits, index[d]).ptr);
-    }
-    name += ']';
-    name += suffix;
-    for (size_t d = index.size(); d-- > 0;) {
-      if (++index[d] <= shape[d]) break;
-      index[d] = 1;
-    }
-  };
+  SubscriptedNames names(prefix, shape, suffix);
   if (!asBlock) {
-    std::vector<std::string> names;
-    for (size_t k = 0; k < count; ++k) formatName(), names.push_back(name);
-    std::vector<std::string_view> views(names.begin(), names.end());
+    std::vector<std::string> owned;
+    for (size_t k = 0; k < count; ++k, names.advance()) owned.emplace_back(names.current());
+    std::vector<std::string_view> views(owned.begin(), owned.end());
     return symbols(views);
   }
   Impl& im = *impl_;
@@ -343,18 +377,16 @@ std::vector<Expr> Context::symbolArray(std::string_view prefix, std::span<const 
   im.blockByFamily.emplace(family, static_cast<uint32_t>(im.blocks.size()));
   im.blocks.push_back({first, static_cast<uint32_t>(count), std::string(prefix), std::string(suffix), {shape.begin(), shape.end()}});
   im.inBlocks += count;
-  // The nodes in one piece of the arena, made as newSymbol makes each (no intern table).
+  // The nodes in one piece of the arena, as newSymbol makes each (no intern table).
   Node* nodes = im.arena.allocate<Node>(count);
-  std::vector<Expr> out;
-  out.reserve(count);
-  for (size_t k = 0; k < count; ++k) {
-    formatName();
-    NodeKey key{.kind = Kind::Symbol, .symbolId = first + static_cast<uint32_t>(k)};
-    computeDerived(key);
-    Expr s = new (nodes + k) Node{.kind = Kind::Symbol, .depth = 0, .symbolId = key.symbolId, .hash = key.hash, .symbolMask = key.symbolMask};
+  std::vector<Expr> out(count);
+  for (size_t k = 0; k < count; ++k, names.advance()) {
+    uint32_t id = first + static_cast<uint32_t>(k);
+    Expr s = new (nodes + k) Node{.kind = Kind::Symbol, .depth = 0, .symbolId = id, .hash = symbolHash(id),
+                                  .symbolMask = uint64_t{1} << (id % 64)};
     im.symbols.push_back(s);
-    im.symbolNames.push_back(im.storeName(name));
-    out.push_back(s);
+    im.symbolNames.push_back(im.storeName(names.current()));
+    out[k] = s;
   }
   im.nodeCount += count;
   return out;

@@ -298,3 +298,23 @@ TEST(Storage, ASymbolArrayIsRecognisedWholeAndWrapped) {
   EXPECT_THROW(ctx.symbolArrayAround(q[1], "der(", ")"), std::logic_error);
   EXPECT_THROW(ctx.symbolArrayAround(other, "der(", ")"), std::logic_error);
 }
+
+// A block's names are written as the subscripts count up in place: every one equals the name
+// formatted from scratch, through carries (9 → 10, 99 → 100) and rows that wrap.
+TEST(Storage, SymbolArrayNamesCountUpThroughCarries) {
+  Context ctx;
+  std::vector<int> line{1005};
+  std::vector<Expr> v = ctx.symbolArray("v", line, ".s");
+  for (int i = 1; i <= 1005; ++i) EXPECT_EQ(ctx.symbolName(v[i - 1]), "v[" + std::to_string(i) + "].s") << i;
+  std::vector<int> grid{11, 3, 12};
+  std::vector<Expr> g = ctx.symbolArray("der(g", grid, ")");
+  size_t k = 0;
+  for (int i = 1; i <= 11; ++i)
+    for (int j = 1; j <= 3; ++j)
+      for (int l = 1; l <= 12; ++l, ++k) {
+        std::string name = "der(g[" + std::to_string(i) + "," + std::to_string(j) + "," + std::to_string(l) + "])";
+        ASSERT_EQ(ctx.symbolName(g[k]), name);
+        EXPECT_EQ(ctx.findSymbol(name), g[k]);
+      }
+  EXPECT_EQ(k, g.size());
+}
