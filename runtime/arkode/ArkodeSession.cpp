@@ -200,6 +200,7 @@ void ArkodeSession::Impl::setup() {
   form = std::make_unique<ExplicitForm>(model, p, kind == LinearSolverKind::Klu);
   if (SUNContext_Create(nullptr, &context) != 0) throw IdaError("SUNContext_Create failed", options.t0);
   y = N_VNew_Serial(n, context);
+  if (y) N_VEnableFusedOps_Serial(y, SUNTRUE);  // as in IdaSession::createVectors: one pass per combination
   yp = N_VNew_Serial(n, context);
   atol = N_VNew_Serial(n, context);
   if (!y || !yp || !atol) throw IdaError("N_VNew_Serial failed (out of memory)", options.t0);

@@ -367,6 +367,11 @@ void IdaSession::Impl::createVectors() {
     ypStep = created(N_VNew_Serial(n, context), "N_VNew_Serial");
   }
   y = created(N_VNew_Serial(n, context), "N_VNew_Serial");
+  // IDA clones its vectors from y: with the fused operations a linear combination of k vectors
+  // (the predictor, the error estimate) is one pass over memory instead of k (N_VScale, then a
+  // N_VLinearSum per vector), which a large model's steps are bound by. The same sums in the same
+  // order: every result is the same to the bit.
+  N_VEnableFusedOps_Serial(y, SUNTRUE);
   yp = created(N_VNew_Serial(n, context), "N_VNew_Serial");
   id = created(N_VNew_Serial(n, context), "N_VNew_Serial");
   atol = created(N_VNew_Serial(n, context), "N_VNew_Serial");
