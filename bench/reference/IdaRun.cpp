@@ -1,5 +1,5 @@
 // simulateReference: SUNDIALS IDA 6.4 over a hand-written ReferenceModel, call for call what
-// qdot's runtime does — IDAInit, per-variable atol (qdot's rule, rt::buildTolerances, with the
+// qdot's runtime does — fused vector operations, IDAInit, per-variable atol (qdot's rule, rt::buildTolerances, with the
 // velocities' time scale from this program's own linearization at the start), IDASetId,
 // IDASetMaxNumSteps, dense or KLU with the analytic Jacobian, IDACalcIC(IDA_YA_YDP_INIT) towards
 // the first output time when F(y0, y'0) != 0 followed by IDAReInit and rebuilt tolerances,
@@ -139,6 +139,7 @@ Integrator::Integrator(const ReferenceModel& model, const RunSettings& settings)
     : model_(model), settings_(settings), n_(model.size()) {
   check(SUNContext_Create(nullptr, &context_), "SUNContext_Create");
   y_ = created(N_VNew_Serial(n_, context_), "N_VNew_Serial");
+  N_VEnableFusedOps_Serial(y_, SUNTRUE);  // as qdot's runtime: IDA's clones do linear combinations in one pass
   yp_ = created(N_VNew_Serial(n_, context_), "N_VNew_Serial");
   id_ = created(N_VNew_Serial(n_, context_), "N_VNew_Serial");
   atol_ = created(N_VNew_Serial(n_, context_), "N_VNew_Serial");
