@@ -50,6 +50,7 @@ llvmbackend::JitOptions backgroundJitOptions() {
   llvmbackend::JitOptions options = llvmbackend::jitOptionsForRun(false);
   options.compiledPrograms = llvmbackend::programBit(ModelProgram::Residual) |
                              llvmbackend::programBit(ModelProgram::Jacobian);
+  options.compileRunOnceFrom = UINT64_MAX;  // the VM has run them before this compile is asked for
   options.threads = std::max(2u, std::thread::hardware_concurrency()) - 1;
   return options;
 }

@@ -67,6 +67,14 @@ Status validate(const kernel::KernelModule& k) {
   return {};
 }
 
+// The options with the programs that run once added where JitOptions::compileRunOnceFrom says.
+JitOptions withLongRunOncePrograms(const kernel::KernelModule& k, JitOptions options) {
+  for (ModelProgram once : {ModelProgram::Parameters, ModelProgram::InitialValues})
+    if (kernel::executedInstructions(k.program(once)) >= options.compileRunOnceFrom)
+      options.compiledPrograms |= programBit(once);
+  return options;
+}
+
 }  // namespace
 
 Result<ModelPtr> createJitModel(const kernel::KernelModule& k, const SourceManager& sm, const JitOptions& options,
@@ -78,7 +86,7 @@ Result<ModelPtr> createJitModel(std::shared_ptr<const kernel::KernelModule> k, c
                                 const JitOptions& options, JitStats* stats) {
   if (Status valid = validate(*k); !valid) return Error{valid.error()};
   // The model holds the kernels it was compiled from: the code reads their index tables in place.
-  auto session = JitSession::compile(*k, options, stats);
+  auto session = JitSession::compile(*k, withLongRunOncePrograms(*k, options), stats);
   if (!session) return Error{session.error()};
   auto m = std::make_unique<JitModel>();
   m->kernels = std::move(k);

@@ -48,6 +48,11 @@ struct JitOptions {
   /// Default: all but parameters and start values, which run once per simulation.
   uint32_t compiledPrograms = programBit(ModelProgram::Residual) | programBit(ModelProgram::Jacobian) |
                               programBit(ModelProgram::Outputs) | programBit(ModelProgram::Invariants);
+  /// ... except that a program that runs once is compiled too when one run of it executes at least
+  /// this many kernel instructions (kernel::executedInstructions): a large model's start values in
+  /// loops. At 10⁶ masses the interpreter spent 60–75 ms of IDA's setup on them (9·10⁶
+  /// instructions); their loop program of 18 instructions compiles in about a millisecond.
+  uint64_t compileRunOnceFrom = 100000;
   /// Compile threads; 0 = one per hardware thread (at most 8).
   unsigned threads = 0;
   /// Run LLVM's IR verifier on every module (the tests do; it costs ~60% of lowering, and the

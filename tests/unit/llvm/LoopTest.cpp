@@ -273,6 +273,52 @@ TEST(Loops, ANaNInsideALoopIsNamedWithItsIterationOnTheVmAndTheJit) {
   }
 }
 
+// Start values of n masses as a large model has them: x_i = 0.01 i by one loop, the 2n rates and
+// nominals 0 by another (what KernelBuilder::numberRuns emits).
+kernel::Program loopedStartValues(uint32_t n) {
+  Writer w;
+  uint32_t step = w.k(0.01), one = w.k(1.0);
+  w.loop(Loop{.count = n, .first = 0, .stride = 1});
+  w.op(Op::StoreLooped, w.op(Op::Mul, step, w.op(Op::Add, w.op(Op::LoadLoopOffset), one)), 0, 0, 0);
+  w.endLoop();
+  uint32_t zero = w.k(0.0);
+  w.loop(Loop{.count = 2 * n, .first = 0, .stride = 1});
+  w.op(Op::StoreLooped, zero, 0, 0, n);
+  w.endLoop();
+  w.p.name = "initialValues", w.p.outputCount = 3 * n;
+  return w.p;
+}
+
+// A program that runs once is left to the interpreter unless one run of it executes at least
+// JitOptions::compileRunOnceFrom instructions (a large model's looped start values); compiled or
+// not, its values are the VM's and the direct computation's, bit for bit.
+TEST(Loops, LongStartValueProgramsAreCompiledShortOnesInterpreted) {
+  for (uint32_t n : {100u, 40000u}) {
+    kernel::KernelModule m = moduleWith(stencil(n), n);
+    m.program(ModelProgram::InitialValues) = loopedStartValues(n);
+    bool long_ = kernel::executedInstructions(m.program(ModelProgram::InitialValues)) >= llvmbackend::JitOptions{}.compileRunOnceFrom;
+    EXPECT_EQ(long_, n == 40000u);
+    SourceManager sm;
+    llvmbackend::JitStats stats;
+    Result<ModelPtr> jit = llvmbackend::createJitModel(m, sm, verified({}), &stats);
+    ASSERT_TRUE(jit.ok()) << jit.error();
+    EXPECT_EQ(stats.functions[programIndex(ModelProgram::InitialValues)] > 0, long_) << n;
+    EXPECT_EQ(stats.functions[programIndex(ModelProgram::Parameters)], 0u) << n;  // one instruction pair
+    Result<ModelPtr> vm = vmModel(m);
+    ASSERT_TRUE(vm.ok()) << vm.error();
+    double k = 1.75;
+    for (QdotModel* q : {jit.value().get(), vm.value().get()}) {
+      std::vector<double> y(n, -1.0), yp(n, -1.0), nominal(n, -1.0);
+      ASSERT_EQ(q->initialValues(q, &k, 0.0, y.data(), yp.data(), nominal.data()), 0) << q->lastError(q);
+      for (uint32_t i = 0; i < n; ++i) {
+        ASSERT_TRUE(sameBits(y[i], 0.01 * (static_cast<double>(i) + 1.0))) << n << " y[" << i << "] = " << y[i];
+        ASSERT_EQ(yp[i], 0.0);
+        ASSERT_EQ(nominal[i], 0.0);
+      }
+    }
+  }
+}
+
 TEST(Loops, PrintersShowTheLoop) {
   kernel::KernelModule m = moduleWith(stencil(6), 6);
   std::ostringstream kernelText, bytecodeText;
