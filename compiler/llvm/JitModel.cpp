@@ -69,9 +69,11 @@ Status validate(const kernel::KernelModule& k) {
 
 // The options with the programs that run once added where JitOptions::compileRunOnceFrom says.
 JitOptions withLongRunOncePrograms(const kernel::KernelModule& k, JitOptions options) {
-  for (ModelProgram once : {ModelProgram::Parameters, ModelProgram::InitialValues})
-    if (kernel::executedInstructions(k.program(once)) >= options.compileRunOnceFrom)
+  for (ModelProgram once : {ModelProgram::Parameters, ModelProgram::InitialValues}) {
+    uint64_t executed = kernel::executedInstructions(k.program(once));
+    if (executed >= options.compileRunOnceFrom && executed >= kRunOnceRepeats * k.program(once).code.size())
       options.compiledPrograms |= programBit(once);
+  }
   return options;
 }
 

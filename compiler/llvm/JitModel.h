@@ -17,6 +17,9 @@
 
 namespace qdot::llvmbackend {
 
+/// See JitOptions::compileRunOnceFrom.
+inline constexpr uint64_t kRunOnceRepeats = 100;
+
 /// Bit of `program` in JitOptions::compiledPrograms.
 constexpr uint32_t programBit(ModelProgram program) { return 1u << programIndex(program); }
 /// Every program (tests compile all six, each at one level, to check every lowering).
@@ -49,10 +52,12 @@ struct JitOptions {
   uint32_t compiledPrograms = programBit(ModelProgram::Residual) | programBit(ModelProgram::Jacobian) |
                               programBit(ModelProgram::Outputs) | programBit(ModelProgram::Invariants);
   /// ... except that a program that runs once is compiled too when one run of it executes at least
-  /// this many kernel instructions (kernel::executedInstructions): a large model's start values in
-  /// loops. At 10⁶ masses the interpreter spent 60–75 ms of IDA's setup on them (9·10⁶
-  /// instructions); their loop program of 18 instructions compiles in about a millisecond.
-  uint64_t compileRunOnceFrom = 100000;
+  /// this many kernel instructions (kernel::executedInstructions) and kRunOnceRepeats times its
+  /// length: a large model's start values in loops. At 10⁶ masses the interpreter spent 60–75 ms of
+  /// IDA's setup on them (9·10⁶ instructions, ~7 ns each); their loop program of 18 instructions
+  /// compiles in about a millisecond. Straight-line code (a run executes each instruction once)
+  /// stays interpreted: level 0 costs ~0.4 µs per instruction, 60 times the interpreter's.
+  uint64_t compileRunOnceFrom = 1000000;
   /// Compile threads; 0 = one per hardware thread (at most 8).
   unsigned threads = 0;
   /// Run LLVM's IR verifier on every module (the tests do; it costs ~60% of lowering, and the

@@ -289,29 +289,44 @@ kernel::Program loopedStartValues(uint32_t n) {
   return w.p;
 }
 
+// Start values stored one instruction each, no loop: a run executes every instruction once.
+kernel::Program straightStartValues(uint32_t n) {
+  Writer w;
+  uint32_t zero = w.k(0.0);
+  for (uint32_t i = 0; i < n; ++i) w.op(Op::Store, w.k(0.01 * (static_cast<double>(i) + 1.0)), 0, 0, i);
+  for (uint32_t i = n; i < 3 * n; ++i) w.op(Op::Store, zero, 0, 0, i);
+  w.p.name = "initialValues", w.p.outputCount = 3 * n;
+  return w.p;
+}
+
 // A program that runs once is left to the interpreter unless one run of it executes at least
-// JitOptions::compileRunOnceFrom instructions (a large model's looped start values); compiled or
-// not, its values are the VM's and the direct computation's, bit for bit.
-TEST(Loops, LongStartValueProgramsAreCompiledShortOnesInterpreted) {
-  for (uint32_t n : {100u, 40000u}) {
-    kernel::KernelModule m = moduleWith(stencil(n), n);
-    m.program(ModelProgram::InitialValues) = loopedStartValues(n);
-    bool long_ = kernel::executedInstructions(m.program(ModelProgram::InitialValues)) >= llvmbackend::JitOptions{}.compileRunOnceFrom;
-    EXPECT_EQ(long_, n == 40000u);
+// JitOptions::compileRunOnceFrom instructions, kRunOnceRepeats times its length (a large model's
+// looped start values; straight-line code never); compiled or not, its values are the VM's and the
+// direct computation's, bit for bit.
+TEST(Loops, LongStartValueLoopsAreCompiledOtherRunOnceCodeInterpreted) {
+  struct Case {
+    uint32_t n;
+    bool looped, compiled;
+  };
+  for (Case c : {Case{100, true, false}, Case{40000, true, true}, Case{4000, false, false}}) {
+    kernel::KernelModule m = moduleWith(stencil(c.n), c.n);
+    m.program(ModelProgram::InitialValues) = c.looped ? loopedStartValues(c.n) : straightStartValues(c.n);
+    llvmbackend::JitOptions options = verified({});
+    options.compileRunOnceFrom = 10000;  // below every case's executed instructions but the smallest
     SourceManager sm;
     llvmbackend::JitStats stats;
-    Result<ModelPtr> jit = llvmbackend::createJitModel(m, sm, verified({}), &stats);
+    Result<ModelPtr> jit = llvmbackend::createJitModel(m, sm, options, &stats);
     ASSERT_TRUE(jit.ok()) << jit.error();
-    EXPECT_EQ(stats.functions[programIndex(ModelProgram::InitialValues)] > 0, long_) << n;
-    EXPECT_EQ(stats.functions[programIndex(ModelProgram::Parameters)], 0u) << n;  // one instruction pair
+    EXPECT_EQ(stats.functions[programIndex(ModelProgram::InitialValues)] > 0, c.compiled) << c.n;
+    EXPECT_EQ(stats.functions[programIndex(ModelProgram::Parameters)], 0u) << c.n;  // two instructions
     Result<ModelPtr> vm = vmModel(m);
     ASSERT_TRUE(vm.ok()) << vm.error();
     double k = 1.75;
     for (QdotModel* q : {jit.value().get(), vm.value().get()}) {
-      std::vector<double> y(n, -1.0), yp(n, -1.0), nominal(n, -1.0);
+      std::vector<double> y(c.n, -1.0), yp(c.n, -1.0), nominal(c.n, -1.0);
       ASSERT_EQ(q->initialValues(q, &k, 0.0, y.data(), yp.data(), nominal.data()), 0) << q->lastError(q);
-      for (uint32_t i = 0; i < n; ++i) {
-        ASSERT_TRUE(sameBits(y[i], 0.01 * (static_cast<double>(i) + 1.0))) << n << " y[" << i << "] = " << y[i];
+      for (uint32_t i = 0; i < c.n; ++i) {
+        ASSERT_TRUE(sameBits(y[i], 0.01 * (static_cast<double>(i) + 1.0))) << c.n << " y[" << i << "] = " << y[i];
         ASSERT_EQ(yp[i], 0.0);
         ASSERT_EQ(nominal[i], 0.0);
       }
