@@ -5,12 +5,16 @@ find_package(SUNDIALS REQUIRED CONFIG)
 find_package(Threads REQUIRED)  # sim/TieredModel: the JIT compiles on a background thread
 find_package(Eigen3 3.4 REQUIRED NO_MODULE)  # ida/DummyDerivatives: small dense QR (header-only)
 
+# ida/ReducedKlu calls KLU itself (the reduced Newton matrix), not only through SUNDIALS' solver.
+find_library(QDOT_KLU_LIBRARY NAMES klu REQUIRED)
+
 add_library(qdot_runtime STATIC ${RUNTIME_SOURCES})
 target_include_directories(qdot_runtime PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include ${CMAKE_CURRENT_SOURCE_DIR})
 target_link_libraries(qdot_runtime
   PUBLIC fmt::fmt CLI11::CLI11 Threads::Threads
   PRIVATE Eigen3::Eigen SUNDIALS::ida_shared SUNDIALS::arkode_shared SUNDIALS::nvecserial_shared SUNDIALS::sunmatrixdense_shared
-          SUNDIALS::sunmatrixsparse_shared SUNDIALS::sunlinsoldense_shared SUNDIALS::sunlinsolklu_shared)
+          SUNDIALS::sunmatrixsparse_shared SUNDIALS::sunlinsoldense_shared SUNDIALS::sunlinsolklu_shared
+          ${QDOT_KLU_LIBRARY})
 
 # qdot_exe_main: the main of standalone model executables (exe/, `qdot build`). qdot links it,
 # with qdot_runtime, qdot_vm and the shared SUNDIALS and fmt libraries, to a generated source file

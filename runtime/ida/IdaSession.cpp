@@ -26,6 +26,7 @@
 #include "ida/InitialSystem.h"
 #include "ida/KluOrdering.h"
 #include "ida/ModelCheck.h"
+#include "ida/ReducedKlu.h"
 #include "qdot/model_description.hpp"
 
 namespace qdot::rt {
@@ -79,6 +80,20 @@ constexpr double kConsistentResidual = 1e-14;
 
 }  // namespace
 
+/// How KLU factors a pattern: with its two-entry rows eliminated first (ida/ReducedKlu.h), or
+/// whole, in a band ordering when RCM finds a narrow band.
+struct KluChoice {
+  std::optional<ReducedKluPlan> reduced;
+  std::optional<BandOrdering> band;
+};
+
+KluChoice chooseKlu(CscPattern pattern, bool eliminate) {
+  KluChoice choice;
+  if (eliminate) choice.reduced = planReducedKlu(pattern);
+  if (!choice.reduced) choice.band = chooseBandOrdering(pattern);
+  return choice;
+}
+
 struct IdaSession::Impl {
   std::unique_ptr<DummyDerivativeModel> dummies;  ///< after index reduction: the square system's choice
   const QdotModel& model;                         ///< what IDA integrates (dummies->square() after index reduction)
@@ -110,9 +125,10 @@ struct IdaSession::Impl {
   std::optional<std::chrono::steady_clock::time_point> firstStepDone;
   bool blockTriangular = true;
   std::optional<BandOrdering> bandOrdering;  ///< KLU: the band ordering it was given (must outlive its analysis)
-  /// The band ordering of columnStarts/rowIndices being made on another thread (orderAhead); declared
-  /// after them, so that it is destroyed (joined) first.
-  std::future<std::optional<BandOrdering>> bandOrderingAhead;
+  bool reduced = false;  ///< KLU: the solver is reducedKluSolver (two-entry rows eliminated first)
+  /// How KLU will factor columnStarts/rowIndices, being decided on another thread (orderAhead);
+  /// declared after them, so that it is destroyed (joined) first.
+  std::future<KluChoice> kluAhead;
 
   // What the last failure was, for the checking helper's message.
   bool modelFailed = false;
@@ -222,6 +238,8 @@ std::string IdaSession::Impl::singularNote() const {
   if (kind == LinearSolverKind::Dense) {
     sunindextype pivot = SUNLinSolLastFlag(solver);  // 1-based column of a zero pivot, else 0
     if (pivot > 0 && pivot <= static_cast<sunindextype>(n)) column = static_cast<long>(pivot - 1);
+  } else if (reduced) {
+    column = static_cast<long>(reducedKluSingularColumn(solver));
   } else {
     // KLU's own status of its last call (the SUNDIALS flag only says "package failure")
     sun_klu_common* common = SUNLinSol_KLUGetCommon(solver);
@@ -358,7 +376,9 @@ void IdaSession::Impl::orderAhead() {
   if (k != LinearSolverKind::Klu) return;
   columnStarts.assign(model.jacobianColumnStarts, model.jacobianColumnStarts + n + 1);
   rowIndices.assign(model.jacobianRowIndices, model.jacobianRowIndices + model.jacobianNonzeros);
-  bandOrderingAhead = std::async(std::launch::async, [this] { return chooseBandOrdering({columnStarts, rowIndices}); });
+  kluAhead = std::async(std::launch::async, [this] {
+    return chooseKlu({columnStarts, rowIndices}, options.eliminateTwoEntryRows);
+  });
 }
 
 void IdaSession::Impl::createVectors() {
@@ -424,19 +444,6 @@ void IdaSession::Impl::applyTolerances(bool calibrated, bool sameY) {
   check(IDASVtolerances(ida, tolerances.solverRtol, atol), "IDASVtolerances");
 }
 
-namespace {
-
-// Whether every column c of a CSC pattern has an entry in row c.
-bool zeroFreeDiagonal(const std::vector<sunindextype>& columnStarts, const std::vector<sunindextype>& rowIndices) {
-  for (size_t c = 0; c + 1 < columnStarts.size(); ++c) {
-    auto begin = rowIndices.begin() + columnStarts[c], end = rowIndices.begin() + columnStarts[c + 1];
-    if (std::find(begin, end, static_cast<sunindextype>(c)) == end) return false;
-  }
-  return true;
-}
-
-}  // namespace
-
 void IdaSession::Impl::attachLinearSolver() {
   uint32_t nnz = model.jacobianNonzeros;
   kind = options.linearSolver == LinearSolverKind::Auto ? chooseLinearSolver(n, nnz) : options.linearSolver;
@@ -448,14 +455,24 @@ void IdaSession::Impl::attachLinearSolver() {
   if (solver) SUNLinSolFree(solver), solver = nullptr;  // a new dummy derivative choice: a new pattern
   if (matrix) SUNMatDestroy(matrix), matrix = nullptr;
   bandOrdering.reset();
+  reduced = false;
   // made ahead of this from the same pattern (joined before the pattern is copied again)
-  std::optional<std::optional<BandOrdering>> ahead;
-  if (bandOrderingAhead.valid()) ahead = bandOrderingAhead.get();
+  std::optional<KluChoice> ahead;
+  if (kluAhead.valid()) ahead = kluAhead.get();
   columnStarts.assign(model.jacobianColumnStarts, model.jacobianColumnStarts + n + 1);
   rowIndices.assign(model.jacobianRowIndices, model.jacobianRowIndices + nnz);
   if (kind == LinearSolverKind::Klu) {
     matrix = created(SUNSparseMatrix(n, n, std::max<uint32_t>(nnz, 1), CSC_MAT, context), "SUNSparseMatrix");
     keepPattern(matrix);
+    KluChoice choice = ahead ? std::move(*ahead) : chooseKlu({columnStarts, rowIndices}, options.eliminateTwoEntryRows);
+    if (choice.reduced) {  // the kinematic rows solved for first: KLU factors the rest (ida/ReducedKlu.h)
+      blockTriangular = choice.reduced->blockTriangular;
+      solver = created(reducedKluSolver(std::move(*choice.reduced), context), "reducedKluSolver");
+      reduced = true;
+      check(IDASetLinearSolver(ida, solver, matrix), "IDASetLinearSolver", FlagFamily::LinearSolverInterface);
+      check(IDASetJacFn(ida, &Impl::jacobianCallback), "IDASetJacFn", FlagFamily::LinearSolverInterface);
+      return;
+    }
     solver = created(SUNLinSol_KLU(y, matrix, context), "SUNLinSol_KLU");
     // KLU's block triangular form starts with a maximum transversal (BTF's maxtrans): one pass
     // when the pattern's diagonal is zero-free, O(n · nnz) at worst otherwise — 92 s of the first
@@ -464,9 +481,9 @@ void IdaSession::Impl::attachLinearSolver() {
     // partial pivoting), which for such a model took 0.09 s.
     // A pattern that RCM turns into a narrow band is ordered so, without BTF (ida/KluOrdering.h):
     // a few breadth-first searches instead of BTF and COLAMD, most of the first step at 10⁶ masses.
-    bandOrdering = ahead ? std::move(*ahead) : chooseBandOrdering({columnStarts, rowIndices});
+    bandOrdering = std::move(choice.band);
     if (bandOrdering) useBandOrdering(*SUNLinSol_KLUGetCommon(solver), *bandOrdering);
-    blockTriangular = !bandOrdering && zeroFreeDiagonal(columnStarts, rowIndices);
+    blockTriangular = !bandOrdering && zeroFreeDiagonal({columnStarts, rowIndices});
     if (!blockTriangular) SUNLinSol_KLUGetCommon(solver)->btf = 0;
   } else {
     jacobianValues.assign(nnz, 0.0);
@@ -859,8 +876,13 @@ bool IdaSession::computedInitialValues() const { return impl_->initialValues != 
 InitialValueMethod IdaSession::initialValueMethod() const { return impl_->initialValues; }
 bool IdaSession::blockTriangular() const { return impl_->blockTriangular; }
 std::optional<int64_t> IdaSession::bandwidth() const {
+  if (impl_->reduced) {
+    const auto& band = reducedKluPlan(impl_->solver).band;
+    return band ? std::optional<int64_t>(band->bandwidth) : std::nullopt;
+  }
   return impl_->bandOrdering ? std::optional<int64_t>(impl_->bandOrdering->bandwidth) : std::nullopt;
 }
+int64_t IdaSession::eliminatedRows() const { return impl_->reduced ? reducedKluPlan(impl_->solver).rows.pairs() : 0; }
 std::optional<std::chrono::steady_clock::time_point> IdaSession::firstStepDone() const { return impl_->firstStepDone; }
 const std::vector<std::string>& IdaSession::warnings() const { return impl_->warnings; }
 

@@ -52,6 +52,9 @@ struct SessionOptions {
   /// not only at output times that may not resolve a fast rotation.
   bool observeSteps = false;
   bool preserveInvariants = false;  ///< --preserve invariants (ArkodeSession only): project after each step
+  /// KLU: eliminate the Newton matrix's two-entry rows (kinematic rows der(q) = v) before the LU
+  /// (ida/ReducedKlu.h); false with --no-row-elimination.
+  bool eliminateTwoEntryRows = true;
 };
 
 /// Counters read from IDA after (or during) a run.
@@ -121,6 +124,8 @@ class IdaSession {
   /// KLU: the half bandwidth when it factors the matrix in reverse Cuthill–McKee order (a narrow
   /// band: ida/KluOrdering.h, without BTF); nullopt when it orders by COLAMD.
   std::optional<int64_t> bandwidth() const;
+  /// KLU: how many two-entry rows (and as many unknowns) were eliminated before the LU (0: none).
+  int64_t eliminatedRows() const;
   bool computedInitialValues() const;                ///< whether the start values were changed
   InitialValueMethod initialValueMethod() const;
   /// When IDA had completed its first step (seen at the next residual evaluation), if it has: the

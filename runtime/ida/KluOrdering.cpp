@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <numeric>
 #include <type_traits>
 #include <utility>
 
@@ -164,8 +165,50 @@ bool bandIsNarrow(int64_t n, int64_t nonzeros, int64_t bandwidth) {
          static_cast<double>(kBandFillFactor) * static_cast<double>(nonzeros);
 }
 
+bool zeroFreeDiagonal(CscPattern pattern) {
+  for (int64_t c = 0; c < pattern.size(); ++c) {
+    auto begin = pattern.rowIndices.begin() + pattern.columnStarts[c];
+    auto end = pattern.rowIndices.begin() + pattern.columnStarts[c + 1];
+    if (std::find(begin, end, c) == end) return false;
+  }
+  return true;
+}
+
+int64_t naturalBandwidth(CscPattern pattern) {
+  int64_t band = 0;
+  for (int64_t j = 0; j < pattern.size(); ++j)
+    for (int64_t k = pattern.columnStarts[j]; k < pattern.columnStarts[j + 1]; ++k)
+      band = std::max(band, std::abs(pattern.rowIndices[k] - j));
+  return band;
+}
+
+int64_t bandwidthLowerBound(CscPattern pattern) {
+  int64_t n = pattern.size(), most = 0;
+  std::vector<int32_t> inRow(n, 0);
+  for (int64_t j = 0; j < n; ++j) {
+    int64_t inColumn = 0;
+    for (int64_t k = pattern.columnStarts[j]; k < pattern.columnStarts[j + 1]; ++k) {
+      int64_t i = pattern.rowIndices[k];
+      if (i == j) continue;
+      ++inColumn;
+      most = std::max<int64_t>(most, ++inRow[i]);
+    }
+    most = std::max(most, inColumn);
+  }
+  return (most + 1) / 2;
+}
+
 std::optional<BandOrdering> chooseBandOrdering(CscPattern pattern) {
   BandOrdering band;
+  // A model's own order is often a band already (a chain's reduced matrix: tridiagonal); when no
+  // ordering can do better, RCM's searches are not made.
+  if (int64_t natural = naturalBandwidth(pattern); natural <= bandwidthLowerBound(pattern)) {
+    if (!bandIsNarrow(pattern.size(), pattern.nonzeros(), natural)) return std::nullopt;
+    band.order.resize(pattern.size());
+    std::iota(band.order.begin(), band.order.end(), int64_t{0});
+    band.bandwidth = natural;
+    return band;
+  }
   band.order = reverseCuthillMcKee(pattern);
   band.bandwidth = permutedBandwidth(pattern, band.order);
   if (!bandIsNarrow(pattern.size(), pattern.nonzeros(), band.bandwidth)) return std::nullopt;

@@ -44,7 +44,20 @@ struct BandOrdering {
   int64_t bandwidth = 0;       ///< half bandwidth after the permutation
 };
 
-/// RCM of the pattern if its band is narrow (bandIsNarrow), else nullopt: KLU keeps COLAMD.
+/// Largest |i − j| over the entries (i, j): the half bandwidth in the pattern's own order.
+int64_t naturalBandwidth(CscPattern pattern);
+
+/// A half bandwidth no symmetric ordering can go below: ⌈d / 2⌉ for the most off-diagonal entries
+/// d in one row or column (a node's d neighbours cannot all be within b − 1 of it). Exact for
+/// patterns without duplicate entries; with them, an upper estimate of this bound.
+int64_t bandwidthLowerBound(CscPattern pattern);
+
+/// Whether every column c has an entry in row c (KLU's block triangular form needs a maximum
+/// transversal otherwise: O(n · nnz) at worst).
+bool zeroFreeDiagonal(CscPattern pattern);
+
+/// RCM of the pattern if its band is narrow (bandIsNarrow), else nullopt: KLU keeps COLAMD. The
+/// pattern's own order instead when its bandwidth is already the lower bound (no search made).
 std::optional<BandOrdering> chooseBandOrdering(CscPattern pattern);
 
 /// Has KLU order its matrix with `ordering` (ordering = 3, a user callback) and factor it without

@@ -33,6 +33,9 @@ void addRunOptions(CLI::App& app, RunOptions& o) {
   app.add_flag("--invariants", o.invariants, "add the model's invariants (energy, momenta) as columns");
   app.add_option("--linear-solver", o.linearSolver, "dense, klu or auto (default auto)")
       ->check(CLI::IsMember({"auto", "dense", "klu"}));
+  app.add_flag("!--no-row-elimination", o.rowElimination,
+               "klu: factor IDA's whole Newton matrix, without first solving its two-entry rows (the kinematic rows "
+               "der(q) = v) for one of their unknowns");
   // --solver (issue 11, section 3)
   app.add_option("--solver", o.solver,
                  "ida (BDF, any model; default), arkode (an L-stable ESDIRK method: models that are ODEs in their "
@@ -179,6 +182,7 @@ ResolvedRun resolveRunOptions(const RunOptions& o, const ExperimentDefaults& e, 
   auto solver = parseLinearSolver(o.linearSolver);
   if (!solver) throw UsageError(fmt::format("--linear-solver must be dense, klu or auto (got '{}')", o.linearSolver));
   s.linearSolver = *solver;
+  s.eliminateTwoEntryRows = o.rowElimination;
   s.invariants = o.invariants;
   // --solver (issue 11, section 3)
   auto integrator = parseSolver(o.solver);

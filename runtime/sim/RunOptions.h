@@ -37,6 +37,7 @@ struct RunOptions {
   // --solver (issue 11, section 3)
   std::string solver = "ida";  ///< --solver ida|arkode|auto
   std::string preserve;        ///< --preserve invariants (issue 11, section 4); "" = none
+  bool rowElimination = true;  ///< false with --no-row-elimination
 };
 
 /// The model's experiment annotation, as far as it gives values.
@@ -54,7 +55,7 @@ inline constexpr double kMaxRowsWithoutForce = 1e7;
 inline constexpr double kRoundOffFloor = 10 * 2.220446049250313e-16;
 
 /// Adds --start --stop --interval --rtol --atol -p --outputs -o --stats --invariants
-/// --linear-solver --csv-names --max-steps --force --no-progress to app, storing into options (which must outlive the parse).
+/// --linear-solver --no-row-elimination --csv-names --max-steps --force --no-progress to app, storing into options (which must outlive the parse).
 void addRunOptions(CLI::App& app, RunOptions& options);
 
 /// The whole of text as a finite number (std::from_chars, no trailing characters), or nullopt.

@@ -144,6 +144,7 @@ SessionOptions sessionOptions(const SimulationSettings& s) {
   o.linearSolver = s.linearSolver;
   o.maxStepsPerOutput = s.maxSteps ? std::min(s.maxStepsPerOutput, *s.maxSteps) : s.maxStepsPerOutput;
   o.preserveInvariants = s.preserveInvariants;
+  o.eliminateTwoEntryRows = s.eliminateTwoEntryRows;
   return o;
 }
 
@@ -167,6 +168,7 @@ void collect(SimulationResult& r, const Session& session) {
   r.initialValues = session.initialValueMethod();
   if constexpr (requires { session.blockTriangular(); }) r.blockTriangular = session.blockTriangular();
   if constexpr (requires { session.bandwidth(); }) r.bandwidth = session.bandwidth();
+  if constexpr (requires { session.eliminatedRows(); }) r.eliminatedRows = session.eliminatedRows();
   r.warnings = session.warnings();
   try {
     r.stats = session.stats();

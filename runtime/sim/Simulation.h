@@ -65,6 +65,7 @@ struct SimulationSettings {
   // --solver (issue 11, section 3): which integrator; Auto picks from the linearization at the start.
   SolverKind solver = SolverKind::Ida;
   bool preserveInvariants = false;  ///< --preserve invariants: project onto their start values (arkode)
+  bool eliminateTwoEntryRows = true;  ///< false with --no-row-elimination (SessionOptions)
 };
 
 /// Seconds of solving after which progress is shown (when SimulationSettings::progress is set).
@@ -83,6 +84,7 @@ struct SimulationResult {
   bool linearSolverChosenAutomatically = false;            ///< --linear-solver auto
   bool blockTriangular = true;  ///< KLU: permuted to block triangular form first (IdaSession::blockTriangular)
   std::optional<int64_t> bandwidth;  ///< KLU: ordered as a band of this half width (IdaSession::bandwidth), else COLAMD
+  int64_t eliminatedRows = 0;        ///< KLU: two-entry rows eliminated before the LU (IdaSession::eliminatedRows)
   bool computedInitialValues = false;
   InitialValueMethod initialValues = InitialValueMethod::AsGiven;
   std::vector<std::string> warnings;

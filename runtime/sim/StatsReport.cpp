@@ -43,12 +43,13 @@ std::string formatStats(const SimulationResult& r) {
   line(out, "error-test failures", fmt::format("{}", s.errorTestFailures));
   line(out, "convergence failures", fmt::format("{}", s.convergenceFailures));
   line(out, "linear solver",
-       fmt::format("{} ({}{})", linearSolverName(r.linearSolver),
+       fmt::format("{} ({}{}{})", linearSolverName(r.linearSolver),
                    r.linearSolverChosenAutomatically ? "chosen automatically" : "as requested",
                    r.linearSolver != LinearSolverKind::Klu ? ""
                    : r.bandwidth ? fmt::format("; band ordering, bandwidth {}", *r.bandwidth)
                    : !r.blockTriangular ? "; without block triangular form: the Jacobian's diagonal has structural zeros"
-                                        : ""));
+                                        : "",
+                   r.eliminatedRows > 0 ? fmt::format("; {} two-entry rows eliminated first", r.eliminatedRows) : ""));
   if (!s.dummyDerivatives.empty())
     line(out, "dummy derivatives",
          fmt::format("{} (index reduction; chosen again {} time{} during the run)", s.dummyDerivatives, s.dummyChanges,

@@ -143,6 +143,33 @@ TEST(ReverseCuthillMcKee, HandlesTheSmallestPatterns) {
   EXPECT_FALSE(chooseBandOrdering(empty.csc()));
 }
 
+// A pattern whose own order already has the smallest possible bandwidth (⌈d/2⌉ for its densest row
+// or column) keeps that order without RCM's searches; one that does not is searched as before.
+TEST(ReverseCuthillMcKee, AnOwnOrderThatCannotBeBeatenIsKept) {
+  const int64_t n = 200;
+  Pattern tridiagonal(n, banded(n, 1, identity(n)));
+  EXPECT_EQ(naturalBandwidth(tridiagonal.csc()), 1);
+  EXPECT_EQ(bandwidthLowerBound(tridiagonal.csc()), 1);
+  auto kept = chooseBandOrdering(tridiagonal.csc());
+  ASSERT_TRUE(kept);
+  EXPECT_EQ(kept->order, identity(n));
+  EXPECT_EQ(kept->bandwidth, 1);
+  Pattern pentadiagonal(n, banded(n, 2, identity(n)));  // 4 neighbours: no order below 2
+  EXPECT_EQ(bandwidthLowerBound(pentadiagonal.csc()), 2);
+  EXPECT_EQ(chooseBandOrdering(pentadiagonal.csc())->order, identity(n));
+  // scrambled: its own bandwidth is far above the bound, RCM finds the band again
+  Pattern scrambled(n, banded(n, 1, scramble(n)));
+  EXPECT_GT(naturalBandwidth(scrambled.csc()), 1);
+  auto searched = chooseBandOrdering(scrambled.csc());
+  ASSERT_TRUE(searched);
+  EXPECT_NE(searched->order, identity(n));
+  EXPECT_EQ(searched->bandwidth, 1);
+  // an arrow (row and column 0 full): the bound is ⌈(n − 1)/2⌉ from either side
+  std::vector<std::pair<int64_t, int64_t>> arrow;
+  for (int64_t i = 0; i < 9; ++i) arrow.emplace_back(i, i), arrow.emplace_back(0, i), arrow.emplace_back(i, 0);
+  EXPECT_EQ(bandwidthLowerBound(Pattern(9, arrow).csc()), 4);
+}
+
 TEST(BandIsNarrow, BoundsTheFillOfPartialPivotingByTenTimesA) {
   // n (3b + 1) <= 10 nnz: at 3 entries per column b = 9 passes and b = 10 does not.
   EXPECT_TRUE(bandIsNarrow(100, 300, 9));
