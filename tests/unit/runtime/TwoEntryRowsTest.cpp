@@ -286,5 +286,62 @@ TEST(ReducedKlu, ASpringChainSessionFollowsItsNormalMode) {
   for (int i = 0; i < n; ++i) EXPECT_NEAR(runs[0][i], runs[1][i], 100 * rtol) << i;
 }
 
+/// springChain with a damper c on every mass against the ground: m v' + c v + K x = 0.
+HandModel dampedChain(int n, int mode, double m, double k, double c) {
+  HandModel model = springChain(n, mode, m, k);
+  auto spring = model.residual;
+  model.residual = [n, c, spring](double t, const double* y, const double* yp, const double* p, double* F) {
+    spring(t, y, yp, p, F);
+    for (int i = 0; i < n; ++i) F[n + i] += c * y[n + i];
+    return 0;
+  };
+  auto springJ = model.jacobian;
+  model.jacobian = [n, m, c, springJ](double t, const double* y, const double* yp, const double* p, double cj,
+                                      JacobianValues& J) {
+    springJ(t, y, yp, p, cj, J);
+    for (int i = 0; i < n; ++i) J(n + i, n + i) = m * cj + c;
+    return 0;
+  };
+  return model;
+}
+
+// Stiff and long: every mode of the chain is overdamped, the slowest decays with e^(−λt), λ the
+// slower root of m s² + c s + k_j = 0 (k_j = m ω_j²), so that the steps grow to hundreds of seconds
+// and the kinematic rows' pivot passes from cj to −1. Started in mode 1 the chain stays in it:
+// x_i(t) = a(t) sin(θ i), a'' m + a' c + a k_1 = 0, a(0) = 1, a'(0) = 0.
+TEST(ReducedKlu, AStiffOverdampedChainOverALongHorizonFollowsItsSlowestMode) {
+  const int n = 300;
+  const double m = 1, k = 1e4, c = 1e4, rtol = 1e-7;
+  double theta = std::numbers::pi / (2 * n + 1), omega2 = 4 * k / m * std::pow(std::sin(theta / 2), 2);
+  // roots of m s² + c s + m ω² = 0, both negative: a(t) = (s2 e^(s1 t) − s1 e^(s2 t)) / (s2 − s1)
+  double disc = std::sqrt(c * c - 4 * m * m * omega2);
+  double s1 = (-c + disc) / (2 * m), s2 = (-c - disc) / (2 * m);
+  auto amplitude = [&](double t) { return (s2 * std::exp(s1 * t) - s1 * std::exp(s2 * t)) / (s2 - s1); };
+  std::vector<double> last;
+  for (bool eliminate : {true, false}) {
+    HandModel model = dampedChain(n, 1, m, k, c);
+    SimulationSettings s;
+    s.stop = 4000, s.interval = 500, s.rtol = rtol;
+    s.linearSolver = LinearSolverKind::Klu;
+    s.eliminateTwoEntryRows = eliminate;
+    MemorySink sink;
+    SimulationResult r = simulate(model.abi(), s, sink);
+    ASSERT_TRUE(r.success) << r.message;
+    EXPECT_EQ(r.eliminatedRows, eliminate ? n : 0);
+    EXPECT_GT(r.stats.lastStep, 10.0);  // long steps: cj < 0.1, the −1 entries are the pivots
+    double worst = 0;
+    for (std::size_t row = 0; row < sink.rows.size(); ++row)
+      for (int i = 0; i < n; ++i)
+        worst = std::max(worst, std::abs(sink.rows[row][i] - amplitude(sink.times[row]) * std::sin(theta * (i + 1))));
+    std::printf("  [measured] overdamped chain n = %d to t = 4000 s, rows eliminated: %s: max |x − exact| %.3g, last "
+                "step %.3g s, %ld steps\n",
+                n, eliminate ? "yes" : "no", worst, r.stats.lastStep, r.stats.steps);
+    EXPECT_LT(worst, 10 * rtol);  // a(4000) ≈ 0.9 (the slow mode barely decays; the fast ones are gone)
+    if (eliminate) last = sink.rows.back();
+    else
+      for (int i = 0; i < n; ++i) EXPECT_NEAR(last[i], sink.rows.back()[i], rtol) << i;
+  }
+}
+
 }  // namespace
 }  // namespace qdot::rt::test
