@@ -63,7 +63,11 @@ TEST(HeapPrefault, PopulatesAheadOfTheWriterAndNotWhatNobodyTouches) {
     mallopt(M_MMAP_MAX, 65536);
     GTEST_SKIP() << "the blocks are not fresh heap here";
   }
-  std::memset(window, 0x5a, kPage);  // the writer starts a window
+  // The writer goes through the windows before `ahead`, a page each. (Touching only the first was
+  // flaky under load: malloc's own headers are writes too, and a look of the prefaulter between the
+  // two mallocs — a smaller heap, a shorter lead — could populate the first windows without
+  // reaching `ahead`, and then count the writer's window as done.)
+  for (char* w = window; w < ahead; w += 2 * kMiB) std::memset(w, 0x5a, kPage);
   bool populated = false;
   for (int k = 0; k < 400 && !populated; ++k) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
