@@ -1,5 +1,5 @@
 // eval_bench: the two backends side by side on one model, in one process (bench/README.md).
-//   eval_bench MODEL.qd [--repeat R] [--no-llvm] [--no-eval] [--calls N] [--min-time S]
+//   eval_bench MODEL.qd [--repeat R] [--no-llvm] [--no-eval] [--loops] [--calls N] [--min-time S]
 // Compiles the file R times (best of R per stage): the front end (parse .. dae, driver::compileFile,
 // as qdot run), kernel::buildKernels, then each backend's code generation — bytecode::emitBytecode +
 // vm::createModel, and llvmbackend::createJitModel with the default options, as
@@ -103,13 +103,14 @@ int main(int argc, char** argv) {
   CLI::App app{"both backends on one model: compile stages and residual/Jacobian ns per call (bench/)"};
   std::string file;
   int repeat = 1;
-  bool noLlvm = false, noEval = false;
+  bool noLlvm = false, noEval = false, loops = false;
   long fixedCalls = 0;
   double minTime = 0.1;
   app.add_option("file", file, "the model file (.qd)")->required()->check(CLI::ExistingFile);
   app.add_option("--repeat", repeat, "compile this many times, best per stage")->check(CLI::PositiveNumber);
   app.add_flag("--no-llvm", noLlvm, "bytecode only");
   app.add_flag("--no-eval", noEval, "compile times only");
+  app.add_flag("--loops", loops, "keep repeated structure as loops, as qdot run does (default: every element on its own)");
   app.add_option("--calls", fixedCalls, "run exactly N calls per loop (for callgrind) instead of timing");
   app.add_option("--min-time", minTime, "seconds per timed batch");
   CLI11_PARSE(app, argc, argv);
@@ -124,6 +125,7 @@ int main(int argc, char** argv) {
     vmModel.reset(), jitModel.reset();
     driver::Compilation c;
     c.options.jit = llvmbackend::JitOptions{};  // the defaults, as qdot run --jit-wait
+    c.options.keepLoops = c.options.eliminateAlgebraics = c.options.rerollRows = loops;  // as qdot run (driver/main.cpp)
     if (!driver::compileFile(c, file, "", driver::Stage::Kernel)) {
       c.diags.render(std::cerr, c.sources);
       return 1;
