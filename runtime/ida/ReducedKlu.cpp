@@ -100,8 +100,9 @@ int setup(SUNLinearSolver s, SUNMatrix A) {
   const TwoEntryRows& rows = c.plan.rows;
   if (SUNSparseMatrix_SparseType(A) != CSC_MAT || size(A) != rows.n) return static_cast<int>(c.lastFlag = SUNLS_ILL_INPUT);
   std::span<const int64_t> starts(SUNSparseMatrix_IndexPointers(A), rows.n + 1);
-  int64_t zeroRow = reduceMatrix(rows, starts, {SUNSparseMatrix_Data(A), static_cast<size_t>(starts.back())}, c.values,
-                                 c.pivots);
+  size_t nnz = static_cast<size_t>(starts.back());
+  int64_t zeroRow = reduceMatrix(rows, starts, {SUNSparseMatrix_IndexValues(A), nnz}, {SUNSparseMatrix_Data(A), nnz},
+                                 c.values, c.pivots);
   if (zeroRow >= 0) {  // a pair row that is zero: J is singular at that row's columns
     c.singularColumn = rows.row[zeroRow];
     return static_cast<int>(c.lastFlag = SUNLS_PACKAGE_FAIL_REC);
@@ -109,15 +110,12 @@ int setup(SUNLinearSolver s, SUNMatrix A) {
   return c.factor();
 }
 
-int solve(SUNLinearSolver s, SUNMatrix A, N_Vector x, N_Vector b, sunrealtype) {
+int solve(SUNLinearSolver s, SUNMatrix, N_Vector x, N_Vector b, sunrealtype) {
   Content& c = content(s);
   const TwoEntryRows& rows = c.plan.rows;
   if (!c.numeric) return static_cast<int>(c.lastFlag = SUNLS_PACKAGE_FAIL_UNREC);
   size_t n = static_cast<size_t>(rows.n);
-  std::span<const int64_t> starts(SUNSparseMatrix_IndexPointers(A), n + 1);
-  size_t nnz = static_cast<size_t>(starts.back());
-  reduceRightHandSide(rows, c.pivots, starts, {SUNSparseMatrix_IndexValues(A), nnz}, {SUNSparseMatrix_Data(A), nnz},
-                      {N_VGetArrayPointer(b), n}, c.rhs, c.pairRhs);
+  reduceRightHandSide(rows, c.pivots, {N_VGetArrayPointer(b), n}, c.rhs, c.pairRhs);
   if (!klu_l_solve(c.symbolic, c.numeric, rows.size(), 1, c.rhs.data(), &c.common))
     return static_cast<int>(c.lastFlag = SUNLS_PACKAGE_FAIL_REC);
   completeSolution(rows, c.pivots, c.rhs, c.pairRhs, {N_VGetArrayPointer(x), n});

@@ -113,8 +113,9 @@ std::optional<TwoEntryRows> findTwoEntryRows(CscPattern pattern) {
   return out;
 }
 
-int64_t reduceMatrix(const TwoEntryRows& rows, std::span<const int64_t> columnStarts, std::span<const double> values,
-                     std::span<double> reduced, PairPivots& pivots) {
+int64_t reduceMatrix(const TwoEntryRows& rows, std::span<const int64_t> columnStarts,
+                     std::span<const int64_t> rowIndices, std::span<const double> values, std::span<double> reduced,
+                     PairPivots& pivots) {
   int64_t pairs = rows.pairs();
   pivots.solvesRow.resize(pairs);
   pivots.pivot.resize(pairs);
@@ -137,20 +138,29 @@ int64_t reduceMatrix(const TwoEntryRows& rows, std::span<const int64_t> columnSt
     for (int64_t k = columnStarts[j]; k < columnStarts[j + 1]; ++k)
       if (int32_t t = rows.target[k]; t >= 0) reduced[t] += factor * values[k];
   }
+  pivots.entryStarts.assign(1, 0);
+  pivots.entryStarts.reserve(pairs + 1);
+  pivots.entryRow.clear(), pivots.entryFactor.clear();
+  for (int64_t q = 0; q < pairs; ++q) {
+    int64_t j = pivots.solvedFor(rows, q);
+    for (int64_t k = columnStarts[j]; k < columnStarts[j + 1]; ++k)
+      if (int32_t r = rows.reducedIndex[rowIndices[k]]; r >= 0 && pivots.pivot[q] != 0) {
+        pivots.entryRow.push_back(r);
+        pivots.entryFactor.push_back(values[k] / pivots.pivot[q]);
+      }
+    pivots.entryStarts.push_back(static_cast<int32_t>(pivots.entryRow.size()));
+  }
   return singular;
 }
 
-void reduceRightHandSide(const TwoEntryRows& rows, const PairPivots& pivots, std::span<const int64_t> columnStarts,
-                         std::span<const int64_t> rowIndices, std::span<const double> values, std::span<const double> b,
+void reduceRightHandSide(const TwoEntryRows& rows, const PairPivots& pivots, std::span<const double> b,
                          std::span<double> reduced, std::span<double> pairRhs) {
   for (int64_t s = 0; s < rows.size(); ++s) reduced[s] = b[rows.originalIndex[s]];
+  // the unknown solved for is (b_row − other · kept) / pivot: its b part moves to the other rows
   for (int64_t q = 0; q < rows.pairs(); ++q) {
-    // the unknown solved for is (b_row − other · kept) / pivot: its b part moves to the other rows
-    pairRhs[q] = b[rows.row[q]];
-    double share = pairRhs[q] / pivots.pivot[q];
-    int64_t j = pivots.solvedFor(rows, q);
-    for (int64_t k = columnStarts[j]; k < columnStarts[j + 1]; ++k)
-      if (int32_t r = rows.reducedIndex[rowIndices[k]]; r >= 0) reduced[r] -= values[k] * share;
+    double share = pairRhs[q] = b[rows.row[q]];
+    for (int32_t e = pivots.entryStarts[q]; e < pivots.entryStarts[q + 1]; ++e)
+      reduced[pivots.entryRow[e]] -= pivots.entryFactor[e] * share;
   }
 }
 

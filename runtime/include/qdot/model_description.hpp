@@ -76,10 +76,11 @@ struct ModelDescription {
     const auto& rows = jacobianRowIndices;
     if (starts.size() != n + 1 || starts[0] != 0 || static_cast<size_t>(starts[n]) != rows.size())
       return "Jacobian column starts are inconsistent";
+    size_t rowsEnd = residualCount();
     for (size_t j = 0; j < n; ++j) {
       if (starts[j] > starts[j + 1]) return "Jacobian column starts decrease";
       for (int32_t k = starts[j]; k < starts[j + 1]; ++k)
-        if (rows[k] < 0 || static_cast<size_t>(rows[k]) >= residualCount() || (k > starts[j] && rows[k] <= rows[k - 1]))
+        if (rows[k] < 0 || static_cast<size_t>(rows[k]) >= rowsEnd || (k > starts[j] && rows[k] <= rows[k - 1]))
           return "Jacobian row indices out of range or not ascending in column " + std::to_string(j);
     }
     return "";

@@ -66,12 +66,12 @@ Sparse chainMatrix(int64_t n, double cj, double m = 1, double k = 1000, double d
 /// x from the reduced system (S solved densely) for J x = b.
 Eigen::VectorXd reducedSolve(const TwoEntryRows& rows, const Sparse& J, const Eigen::VectorXd& b, PairPivots& pivots) {
   std::vector<double> S(rows.rowIndices.size());
-  EXPECT_EQ(reduceMatrix(rows, J.starts, J.values, S, pivots), -1);
+  EXPECT_EQ(reduceMatrix(rows, J.starts, J.rows, J.values, S, pivots), -1);
   Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(rows.size(), rows.size());
   for (int64_t c = 0; c < rows.size(); ++c)
     for (int64_t k = rows.columnStarts[c]; k < rows.columnStarts[c + 1]; ++k) dense(rows.rowIndices[k], c) = S[k];
   std::vector<double> rhs(rows.size()), pairRhs(rows.pairs()), bv(b.data(), b.data() + b.size());
-  reduceRightHandSide(rows, pivots, J.starts, J.rows, J.values, bv, rhs, pairRhs);
+  reduceRightHandSide(rows, pivots, bv, rhs, pairRhs);
   Eigen::VectorXd s = dense.partialPivLu().solve(Eigen::Map<Eigen::VectorXd>(rhs.data(), rows.size()));
   std::vector<double> x(J.n);
   completeSolution(rows, pivots, {s.data(), static_cast<size_t>(s.size())}, pairRhs, x);
@@ -177,7 +177,7 @@ TEST(TwoEntryRows, AZeroPairRowIsReportedAsSingular) {
   ASSERT_TRUE(rows);
   std::vector<double> S(rows->rowIndices.size());
   PairPivots pivots;
-  EXPECT_EQ(reduceMatrix(*rows, J.starts, J.values, S, pivots), 0);
+  EXPECT_EQ(reduceMatrix(*rows, J.starts, J.rows, J.values, S, pivots), 0);
 }
 
 /// The SUNDIALS solver on the chain matrix: first setup (analysis, factorization), then new values
