@@ -456,11 +456,13 @@ void IdaSession::Impl::attachLinearSolver() {
   if (matrix) SUNMatDestroy(matrix), matrix = nullptr;
   bandOrdering.reset();
   reduced = false;
-  // made ahead of this from the same pattern (joined before the pattern is copied again)
+  // made ahead of this from the same pattern, which orderAhead copied into columnStarts/rowIndices
   std::optional<KluChoice> ahead;
   if (kluAhead.valid()) ahead = kluAhead.get();
-  columnStarts.assign(model.jacobianColumnStarts, model.jacobianColumnStarts + n + 1);
-  rowIndices.assign(model.jacobianRowIndices, model.jacobianRowIndices + nnz);
+  if (!ahead) {
+    columnStarts.assign(model.jacobianColumnStarts, model.jacobianColumnStarts + n + 1);
+    rowIndices.assign(model.jacobianRowIndices, model.jacobianRowIndices + nnz);
+  }
   if (kind == LinearSolverKind::Klu) {
     matrix = created(SUNSparseMatrix(n, n, std::max<uint32_t>(nnz, 1), CSC_MAT, context), "SUNSparseMatrix");
     keepPattern(matrix);
