@@ -38,7 +38,7 @@ struct Content {
   }
 
   SuiteSparse_long* Sp() { return const_cast<SuiteSparse_long*>(plan.rows.columnStarts.data()); }
-  // KLU refuses a null array even where it reads nothing (S without entries: all pair rows)
+  // KLU refuses a null array even where it reads nothing (an S without entries: the rows left empty)
   SuiteSparse_long* Si() {
     static SuiteSparse_long none = 0;
     return plan.rows.rowIndices.empty() ? &none : const_cast<SuiteSparse_long*>(plan.rows.rowIndices.data());
