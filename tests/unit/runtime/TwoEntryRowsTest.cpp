@@ -12,6 +12,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <numbers>
 #include <random>
 #include <set>
@@ -259,29 +260,43 @@ HandModel springChain(int n, int mode, double m, double k) {
   return model;
 }
 
+/// A chain of n masses (x first, then v) run on KLU to `stop`, with or without its kinematic rows
+/// eliminated (every one of them when they are); the largest |x_i − exact(t, i)| over the rows.
+struct ChainRun {
+  SimulationResult result;
+  double worst = 0;
+  std::vector<double> last;  ///< the last row
+};
+ChainRun runChainOnKlu(HandModel model, int n, double stop, double interval, double rtol, bool eliminate,
+                       const std::function<double(double, int)>& exact) {
+  SimulationSettings s;
+  s.stop = stop, s.interval = interval, s.rtol = rtol;
+  s.linearSolver = LinearSolverKind::Klu;
+  s.eliminateTwoEntryRows = eliminate;
+  MemorySink sink;
+  ChainRun run{simulate(model.abi(), s, sink)};
+  EXPECT_TRUE(run.result.success) << run.result.message;
+  EXPECT_EQ(run.result.eliminatedRows, eliminate ? n : 0);
+  for (std::size_t row = 0; row < sink.rows.size(); ++row)
+    for (int i = 0; i < n; ++i) run.worst = std::max(run.worst, std::abs(sink.rows[row][i] - exact(sink.times[row], i)));
+  if (!sink.rows.empty()) run.last = sink.rows.back();
+  return run;
+}
+
 TEST(ReducedKlu, ASpringChainSessionFollowsItsNormalMode) {
   const int n = 400, mode = 3;
   const double m = 2, k = 500, rtol = 1e-8;
   double theta = (2 * mode - 1) * std::numbers::pi / (2 * n + 1), omega = 2 * std::sqrt(k / m) * std::sin(theta / 2);
   std::vector<std::vector<double>> runs;
   for (bool eliminate : {true, false}) {
-    HandModel model = springChain(n, mode, m, k);
-    SimulationSettings s;
-    s.stop = 2, s.interval = 0.5, s.rtol = rtol;
-    s.linearSolver = LinearSolverKind::Klu;
-    s.eliminateTwoEntryRows = eliminate;
-    MemorySink sink;
-    SimulationResult r = simulate(model.abi(), s, sink);
-    ASSERT_TRUE(r.success) << r.message;
-    EXPECT_EQ(r.eliminatedRows, eliminate ? n : 0);
-    double worst = 0;
-    for (std::size_t row = 0; row < sink.rows.size(); ++row)
-      for (int i = 0; i < n; ++i)
-        worst = std::max(worst, std::abs(sink.rows[row][i] - std::cos(omega * sink.times[row]) * std::sin(theta * (i + 1))));
-    std::printf("  [measured] spring chain n = %d, mode %d, rows eliminated: %s: max |x − exact| %.3g over %zu rows\n", n,
-                mode, eliminate ? "yes" : "no", worst, sink.rows.size());
-    EXPECT_LT(worst, 1000 * rtol);
-    runs.push_back(sink.rows.back());
+    ChainRun run = runChainOnKlu(springChain(n, mode, m, k), n, 2, 0.5, rtol, eliminate, [&](double t, int i) {
+      return std::cos(omega * t) * std::sin(theta * (i + 1));
+    });
+    ASSERT_TRUE(run.result.success);
+    std::printf("  [measured] spring chain n = %d, mode %d, rows eliminated: %s: max |x − exact| %.3g\n", n, mode,
+                eliminate ? "yes" : "no", run.worst);
+    EXPECT_LT(run.worst, 1000 * rtol);
+    runs.push_back(run.last);
   }
   for (int i = 0; i < n; ++i) EXPECT_NEAR(runs[0][i], runs[1][i], 100 * rtol) << i;
 }
@@ -319,27 +334,19 @@ TEST(ReducedKlu, AStiffOverdampedChainOverALongHorizonFollowsItsSlowestMode) {
   auto amplitude = [&](double t) { return (s2 * std::exp(s1 * t) - s1 * std::exp(s2 * t)) / (s2 - s1); };
   std::vector<double> last;
   for (bool eliminate : {true, false}) {
-    HandModel model = dampedChain(n, 1, m, k, c);
-    SimulationSettings s;
-    s.stop = 4000, s.interval = 500, s.rtol = rtol;
-    s.linearSolver = LinearSolverKind::Klu;
-    s.eliminateTwoEntryRows = eliminate;
-    MemorySink sink;
-    SimulationResult r = simulate(model.abi(), s, sink);
-    ASSERT_TRUE(r.success) << r.message;
-    EXPECT_EQ(r.eliminatedRows, eliminate ? n : 0);
+    ChainRun run = runChainOnKlu(dampedChain(n, 1, m, k, c), n, 4000, 500, rtol, eliminate, [&](double t, int i) {
+      return amplitude(t) * std::sin(theta * (i + 1));
+    });
+    ASSERT_TRUE(run.result.success);
+    const SimulationResult& r = run.result;
     EXPECT_GT(r.stats.lastStep, 10.0);  // long steps: cj < 0.1, the −1 entries are the pivots
-    double worst = 0;
-    for (std::size_t row = 0; row < sink.rows.size(); ++row)
-      for (int i = 0; i < n; ++i)
-        worst = std::max(worst, std::abs(sink.rows[row][i] - amplitude(sink.times[row]) * std::sin(theta * (i + 1))));
     std::printf("  [measured] overdamped chain n = %d to t = 4000 s, rows eliminated: %s: max |x − exact| %.3g, last "
                 "step %.3g s, %ld steps\n",
-                n, eliminate ? "yes" : "no", worst, r.stats.lastStep, r.stats.steps);
-    EXPECT_LT(worst, 10 * rtol);  // a(4000) ≈ 0.9 (the slow mode barely decays; the fast ones are gone)
-    if (eliminate) last = sink.rows.back();
+                n, eliminate ? "yes" : "no", run.worst, r.stats.lastStep, r.stats.steps);
+    EXPECT_LT(run.worst, 10 * rtol);  // a(4000) ≈ 0.9 (the slow mode barely decays; the fast ones are gone)
+    if (eliminate) last = run.last;
     else
-      for (int i = 0; i < n; ++i) EXPECT_NEAR(last[i], sink.rows.back()[i], rtol) << i;
+      for (int i = 0; i < n; ++i) EXPECT_NEAR(last[i], run.last[i], rtol) << i;
   }
 }
 
