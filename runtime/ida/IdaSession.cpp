@@ -884,6 +884,7 @@ std::optional<int64_t> IdaSession::bandwidth() const {
   }
   return impl_->bandOrdering ? std::optional<int64_t>(impl_->bandOrdering->bandwidth) : std::nullopt;
 }
+bool IdaSession::reducedAsBand() const { return impl_->reduced && reducedKluBanded(impl_->solver); }
 int64_t IdaSession::eliminatedRows() const { return impl_->reduced ? reducedKluPlan(impl_->solver).rows.pairs() : 0; }
 std::optional<std::chrono::steady_clock::time_point> IdaSession::firstStepDone() const { return impl_->firstStepDone; }
 const std::vector<std::string>& IdaSession::warnings() const { return impl_->warnings; }

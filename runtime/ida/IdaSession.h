@@ -126,6 +126,8 @@ class IdaSession {
   std::optional<int64_t> bandwidth() const;
   /// KLU: how many two-entry rows (and as many unknowns) were eliminated before the LU (0: none).
   int64_t eliminatedRows() const;
+  /// KLU with rows eliminated: whether the rest is factored as a band (ida/BandLu.h) instead of by KLU.
+  bool reducedAsBand() const;
   bool computedInitialValues() const;                ///< whether the start values were changed
   InitialValueMethod initialValueMethod() const;
   /// When IDA had completed its first step (seen at the next residual evaluation), if it has: the

@@ -1,4 +1,5 @@
-// IDA's Newton matrix with its two-entry rows eliminated, the rest factored by KLU (ReducedKlu.h).
+// IDA's Newton matrix with its two-entry rows eliminated, the rest factored by KLU or, in a
+// narrow band, by a band LU (ReducedKlu.h).
 #include "ida/ReducedKlu.h"
 
 #include <klu.h>
@@ -9,9 +10,51 @@
 #include <cmath>
 #include <new>
 
+#include "ida/BandLu.h"
+
 namespace qdot::rt {
 
 namespace {
+
+// S in the plan's band ordering, factored by BandLu: its positions in the band storage, made once.
+struct BandedS {
+  BandLu lu;
+  std::vector<int64_t> order;        ///< position k holds S's index order[k]; empty: S's own order
+  std::vector<int64_t> entryOffset;  ///< per entry of S: its place in lu.storage()
+  std::vector<double> permuted;      ///< a right-hand side in band order (when `order` is not empty)
+};
+
+// A band LU computes every entry inside its band, KLU only the nonzeros and their fill: the band
+// is used when at least a third of it is S's entries (a chain's tridiagonal S: all of it). Whole
+// chain matrices (bandwidth 3, 8 entries in a band of 7 per column, but U's fill makes it 10)
+// measured slower with SUNDIALS' band LU than with KLU (bench/README.md, session 20).
+constexpr int64_t kBandFullness = 3;
+
+// S in the band ordering, for BandLu: the band's lower and upper widths in that ordering (RCM's
+// band is symmetric, a matrix's need not be) and where each entry of S goes; nullopt when the
+// band is mostly zeros (above).
+std::optional<BandedS> bandedS(const TwoEntryRows& rows, const BandOrdering& band) {
+  int64_t n = rows.size();
+  bool own = true;
+  for (int64_t k = 0; k < n && own; ++k) own = band.order[static_cast<size_t>(k)] == k;
+  std::vector<int64_t> position(own ? 0 : static_cast<size_t>(n));
+  for (int64_t k = 0; k < n && !own; ++k) position[static_cast<size_t>(band.order[static_cast<size_t>(k)])] = k;
+  auto at = [&](int64_t i) { return own ? i : position[static_cast<size_t>(i)]; };
+  int64_t lower = 0, upper = 0;
+  for (int64_t j = 0; j < n; ++j)
+    for (int64_t e = rows.columnStarts[j]; e < rows.columnStarts[j + 1]; ++e) {
+      int64_t d = at(rows.rowIndices[e]) - at(j);
+      lower = std::max(lower, d), upper = std::max(upper, -d);
+    }
+  if (n * (lower + upper + 1) > kBandFullness * static_cast<int64_t>(rows.rowIndices.size())) return std::nullopt;
+  BandedS s{BandLu(n, lower, upper), own ? std::vector<int64_t>{} : band.order, {}, {}};
+  s.entryOffset.resize(rows.rowIndices.size());
+  for (int64_t j = 0; j < n; ++j)
+    for (int64_t e = rows.columnStarts[j]; e < rows.columnStarts[j + 1]; ++e)
+      s.entryOffset[static_cast<size_t>(e)] = s.lu.offset(at(rows.rowIndices[e]), at(j));
+  if (!own) s.permuted.assign(static_cast<size_t>(n), 0.0);
+  return s;
+}
 
 struct Content {
   ReducedKluPlan plan;
@@ -21,12 +64,15 @@ struct Content {
   std::vector<double> values;        // S's values
   PairPivots pivots;
   std::vector<double> rhs, pairRhs;  // S's right-hand side (then its solution), the pair rows' b
+  std::optional<BandedS> banded;     // a band ordering: S factored as a band, not by KLU
+  bool factored = false;             // banded: the last factorization succeeded
   int64_t singularColumn = -1;
   sunindextype lastFlag = SUNLS_SUCCESS;
 
   explicit Content(ReducedKluPlan p) : plan(std::move(p)) {
     klu_l_defaults(&common);
-    if (plan.band) useBandOrdering(common, *plan.band);  // the plan lives here: it outlives the analysis
+    if (plan.band) banded = bandedS(plan.rows, *plan.band);
+    if (plan.band && !banded) useBandOrdering(common, *plan.band);  // the plan lives here: it outlives the analysis
     if (!plan.blockTriangular) common.btf = 0;
     values.assign(std::max<size_t>(plan.rows.rowIndices.size(), 1), 0.0);
     rhs.assign(plan.rows.size(), 0.0);
@@ -59,9 +105,40 @@ struct Content {
     return pivots.kept(rows, q);
   }
 
-  // The first factorization pivots; later ones reuse its pivot order (refactor) unless KLU's
+  // A band is factored with partial pivoting every time: a pass over its storage, cheaper than
+  // KLU's refactorization without pivoting. A zero pivot names its column's unknown.
+  int factorBand() {
+    BandedS& b = *banded;
+    b.lu.clear();
+    std::span<double> band = b.lu.storage();
+    for (size_t e = 0; e < b.entryOffset.size(); ++e) band[static_cast<size_t>(b.entryOffset[e])] = values[e];
+    int64_t zero = b.lu.factor();
+    factored = zero < 0;
+    if (factored) return static_cast<int>(lastFlag = SUNLS_SUCCESS);
+    singularColumn = unknownOf(b.order.empty() ? zero : b.order[static_cast<size_t>(zero)]);
+    return static_cast<int>(lastFlag = SUNLS_PACKAGE_FAIL_REC);
+  }
+
+  // S's solution in place of its right-hand side `rhs`.
+  bool solveReduced() {
+    if (!banded) return klu_l_solve(symbolic, numeric, plan.rows.size(), 1, rhs.data(), &common) != 0;
+    BandedS& b = *banded;
+    if (b.order.empty()) {
+      b.lu.solve(rhs);
+      return true;
+    }
+    for (size_t k = 0; k < b.order.size(); ++k) b.permuted[k] = rhs[static_cast<size_t>(b.order[k])];
+    b.lu.solve(b.permuted);
+    for (size_t k = 0; k < b.order.size(); ++k) rhs[static_cast<size_t>(b.order[k])] = b.permuted[k];
+    return true;
+  }
+
+  bool ready() const { return banded ? factored : numeric != nullptr; }
+
+  // KLU: the first factorization pivots; later ones reuse its pivot order (refactor) unless KLU's
   // condition estimates say that order has gone bad, as SUNDIALS' KLU solver does.
   int factor() {
+    if (banded) return factorBand();
     if (!symbolic && !(symbolic = klu_l_analyze(plan.rows.size(), Sp(), Si(), &common)))
       return fail(SUNLS_PACKAGE_FAIL_UNREC);
     if (!numeric) {
@@ -90,6 +167,7 @@ int64_t size(SUNMatrix A) { return SUNSparseMatrix_Columns(A); }
 int initialize(SUNLinearSolver s) {
   Content& c = content(s);
   if (c.numeric) klu_l_free_numeric(&c.numeric, &c.common);  // the next setup factors with pivoting
+  c.factored = false;
   c.lastFlag = SUNLS_SUCCESS;
   return SUNLS_SUCCESS;
 }
@@ -97,6 +175,7 @@ int initialize(SUNLinearSolver s) {
 int setup(SUNLinearSolver s, SUNMatrix A) {
   Content& c = content(s);
   c.singularColumn = -1;
+  c.factored = false;
   const TwoEntryRows& rows = c.plan.rows;
   if (SUNSparseMatrix_SparseType(A) != CSC_MAT || size(A) != rows.n) return static_cast<int>(c.lastFlag = SUNLS_ILL_INPUT);
   std::span<const int64_t> starts(SUNSparseMatrix_IndexPointers(A), rows.n + 1);
@@ -113,11 +192,10 @@ int setup(SUNLinearSolver s, SUNMatrix A) {
 int solve(SUNLinearSolver s, SUNMatrix, N_Vector x, N_Vector b, sunrealtype) {
   Content& c = content(s);
   const TwoEntryRows& rows = c.plan.rows;
-  if (!c.numeric) return static_cast<int>(c.lastFlag = SUNLS_PACKAGE_FAIL_UNREC);
+  if (!c.ready()) return static_cast<int>(c.lastFlag = SUNLS_PACKAGE_FAIL_UNREC);
   size_t n = static_cast<size_t>(rows.n);
   reduceRightHandSide(rows, c.pivots, {N_VGetArrayPointer(b), n}, c.rhs, c.pairRhs);
-  if (!klu_l_solve(c.symbolic, c.numeric, rows.size(), 1, c.rhs.data(), &c.common))
-    return static_cast<int>(c.lastFlag = SUNLS_PACKAGE_FAIL_REC);
+  if (!c.solveReduced()) return static_cast<int>(c.lastFlag = SUNLS_PACKAGE_FAIL_REC);
   completeSolution(rows, c.pivots, c.rhs, c.pairRhs, {N_VGetArrayPointer(x), n});
   return static_cast<int>(c.lastFlag = SUNLS_SUCCESS);
 }
@@ -162,5 +240,7 @@ SUNLinearSolver reducedKluSolver(ReducedKluPlan plan, SUNContext context) {
 const ReducedKluPlan& reducedKluPlan(SUNLinearSolver solver) { return content(solver).plan; }
 
 int64_t reducedKluSingularColumn(SUNLinearSolver solver) { return content(solver).singularColumn; }
+
+bool reducedKluBanded(SUNLinearSolver solver) { return content(solver).banded.has_value(); }
 
 }  // namespace qdot::rt

@@ -169,6 +169,7 @@ void collect(SimulationResult& r, const Session& session) {
   if constexpr (requires { session.blockTriangular(); }) r.blockTriangular = session.blockTriangular();
   if constexpr (requires { session.bandwidth(); }) r.bandwidth = session.bandwidth();
   if constexpr (requires { session.eliminatedRows(); }) r.eliminatedRows = session.eliminatedRows();
+  if constexpr (requires { session.reducedAsBand(); }) r.reducedAsBand = session.reducedAsBand();
   r.warnings = session.warnings();
   try {
     r.stats = session.stats();

@@ -85,6 +85,7 @@ struct SimulationResult {
   bool blockTriangular = true;  ///< KLU: permuted to block triangular form first (IdaSession::blockTriangular)
   std::optional<int64_t> bandwidth;  ///< KLU: ordered as a band of this half width (IdaSession::bandwidth), else COLAMD
   int64_t eliminatedRows = 0;        ///< KLU: two-entry rows eliminated before the LU (IdaSession::eliminatedRows)
+  bool reducedAsBand = false;        ///< and the rest factored as a band (IdaSession::reducedAsBand)
   bool computedInitialValues = false;
   InitialValueMethod initialValues = InitialValueMethod::AsGiven;
   std::vector<std::string> warnings;

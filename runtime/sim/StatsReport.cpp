@@ -49,7 +49,9 @@ std::string formatStats(const SimulationResult& r) {
                    : r.bandwidth ? fmt::format("; band ordering, bandwidth {}", *r.bandwidth)
                    : !r.blockTriangular ? "; without block triangular form: the Jacobian's diagonal has structural zeros"
                                         : "",
-                   r.eliminatedRows > 0 ? fmt::format("; {} two-entry rows eliminated first", r.eliminatedRows) : ""));
+                   r.eliminatedRows > 0 ? fmt::format("; {} two-entry rows eliminated first{}", r.eliminatedRows,
+                                                       r.reducedAsBand ? ", the rest by a band LU with partial pivoting" : "")
+                                       : ""));
   if (!s.dummyDerivatives.empty())
     line(out, "dummy derivatives",
          fmt::format("{} (index reduction; chosen again {} time{} during the run)", s.dummyDerivatives, s.dummyChanges,

@@ -181,17 +181,38 @@ TEST(TwoEntryRows, AZeroPairRowIsReportedAsSingular) {
   EXPECT_EQ(reduceMatrix(*rows, J.starts, J.rows, J.values, S, pivots), 0);
 }
 
-/// The SUNDIALS solver on the chain matrix: first setup (analysis, factorization), then new values
-/// (refactorization), each solve against Eigen's dense LU of the whole matrix.
-TEST(ReducedKlu, SolvesThroughSetupAndRefactorization) {
+/// The chain matrix with its masses numbered in the order `mass` (x of mass i at mass[i], v at
+/// n + mass[i]): the same pair rows, but S is a band only in another order than its own.
+Sparse scrambledChain(int64_t n, double cj, const std::vector<int64_t>& mass, double m = 1, double k = 1000,
+                      double d = 0.5) {
+  Sparse J = chainMatrix(n, cj, m, k, d);
+  auto at = [&](int64_t i) { return i < n ? mass[i] : n + mass[i - n]; };
+  std::vector<std::tuple<int64_t, int64_t, double>> e;
+  for (int64_t c = 0; c < J.n; ++c)
+    for (int64_t k2 = J.starts[c]; k2 < J.starts[c + 1]; ++k2) e.emplace_back(at(J.rows[k2]), at(c), J.values[k2]);
+  return Sparse(J.n, e);
+}
+
+enum class ReducedFactor { OwnBand, PermutedBand, Klu };
+
+/// The SUNDIALS solver on a chain matrix: first setup, then new values (KLU: refactorization),
+/// each solve against Eigen's dense LU of the whole matrix; then a singular matrix. S is factored
+/// as a band in its own order, as a band in RCM's order, or (the band taken from the plan) by KLU.
+void solveThroughSetups(ReducedFactor how) {
   SUNContext context = nullptr;
   ASSERT_EQ(SUNContext_Create(nullptr, &context), 0);
   const int64_t n = 50;
-  Sparse J = chainMatrix(n, 1e3);
+  std::vector<int64_t> mass(n);
+  for (int64_t i = 0; i < n; ++i) mass[i] = how == ReducedFactor::PermutedBand ? (17 * i) % n : i;  // 17 and 50 coprime
+  auto matrix = [&](double cj, double m = 1, double k = 1000, double d = 0.5) { return scrambledChain(n, cj, mass, m, k, d); };
+  Sparse J = matrix(1e3);
   std::optional<ReducedKluPlan> plan = planReducedKlu(J.csc());
   ASSERT_TRUE(plan);
-  ASSERT_TRUE(plan->band);  // S is tridiagonal in its own order: no search, bandwidth 1
+  ASSERT_TRUE(plan->band);  // S is tridiagonal: in its own order (no search) or RCM's, bandwidth 1
   EXPECT_EQ(plan->band->bandwidth, 1);
+  bool own = std::is_sorted(plan->band->order.begin(), plan->band->order.end());
+  EXPECT_EQ(own, how != ReducedFactor::PermutedBand);
+  if (how == ReducedFactor::Klu) plan->band.reset();
   SUNMatrix A = SUNSparseMatrix(J.n, J.n, static_cast<sunindextype>(J.rows.size()), CSC_MAT, context);
   std::copy(J.starts.begin(), J.starts.end(), SUNSparseMatrix_IndexPointers(A));
   std::copy(J.rows.begin(), J.rows.end(), SUNSparseMatrix_IndexValues(A));
@@ -200,7 +221,7 @@ TEST(ReducedKlu, SolvesThroughSetupAndRefactorization) {
   ASSERT_EQ(SUNLinSolInitialize(solver), 0);
   N_Vector x = N_VNew_Serial(J.n, context), b = N_VNew_Serial(J.n, context);
   for (double cj : {1e3, 2e3, 0.5}) {
-    Sparse now = chainMatrix(n, cj);
+    Sparse now = matrix(cj);
     std::copy(now.values.begin(), now.values.end(), SUNSparseMatrix_Data(A));
     ASSERT_EQ(SUNLinSolSetup(solver, A), 0) << "cj = " << cj;
     Eigen::VectorXd rhs(J.n);
@@ -211,13 +232,41 @@ TEST(ReducedKlu, SolvesThroughSetupAndRefactorization) {
     EXPECT_LT((got - exact).norm(), 1e-10 * exact.norm()) << "cj = " << cj;
   }
   // a singular matrix: the two masses' rows dependent (a zero stiffness and mass, no damper)
-  Sparse singular = chainMatrix(n, 0.0, 0.0, 0.0, 0.0);
+  Sparse singular = matrix(0.0, 0.0, 0.0, 0.0);
   std::copy(singular.values.begin(), singular.values.end(), SUNSparseMatrix_Data(A));
   EXPECT_NE(SUNLinSolSetup(solver, A), 0);
   int64_t column = reducedKluSingularColumn(solver);
   EXPECT_GE(column, 0);
   EXPECT_LT(column, J.n);
   N_VDestroy(x), N_VDestroy(b);
+  SUNLinSolFree(solver);
+  SUNMatDestroy(A);
+  SUNContext_Free(&context);
+}
+
+TEST(ReducedKlu, SolvesThroughSetupsWithSAsABandInItsOwnOrder) { solveThroughSetups(ReducedFactor::OwnBand); }
+TEST(ReducedKlu, SolvesThroughSetupsWithSAsABandInAnotherOrder) { solveThroughSetups(ReducedFactor::PermutedBand); }
+TEST(ReducedKlu, SolvesThroughSetupsAndRefactorizationsWithKlu) { solveThroughSetups(ReducedFactor::Klu); }
+
+// The singular column named is an unknown whose column of J is zero in the reduced system: a
+// chain whose masses 0..n-1 have zero mass, stiffness and damping has S = 0 (every column). A band
+// factorization stops at its first column; that column stands for x or v of the mass there.
+TEST(ReducedKlu, TheSingularColumnOfABandIsAnUnknownOfItsMass) {
+  SUNContext context = nullptr;
+  ASSERT_EQ(SUNContext_Create(nullptr, &context), 0);
+  const int64_t n = 8;
+  Sparse J = chainMatrix(n, 1.0, 0.0, 0.0, 0.0);
+  std::optional<ReducedKluPlan> plan = planReducedKlu(J.csc());
+  ASSERT_TRUE(plan && plan->band);
+  SUNMatrix A = SUNSparseMatrix(J.n, J.n, static_cast<sunindextype>(J.rows.size()), CSC_MAT, context);
+  std::copy(J.starts.begin(), J.starts.end(), SUNSparseMatrix_IndexPointers(A));
+  std::copy(J.rows.begin(), J.rows.end(), SUNSparseMatrix_IndexValues(A));
+  std::copy(J.values.begin(), J.values.end(), SUNSparseMatrix_Data(A));
+  SUNLinearSolver solver = reducedKluSolver(std::move(*plan), context);
+  ASSERT_EQ(SUNLinSolInitialize(solver), 0);
+  EXPECT_NE(SUNLinSolSetup(solver, A), 0);
+  int64_t column = reducedKluSingularColumn(solver);
+  EXPECT_TRUE(column == 0 || column == n) << column;  // x or v of the first mass
   SUNLinSolFree(solver);
   SUNMatDestroy(A);
   SUNContext_Free(&context);
