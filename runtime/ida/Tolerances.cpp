@@ -52,14 +52,16 @@ void rescale(ToleranceVector& t, double solverRtol) {
   s.atolUser = t.solverRtol = s.solverRtol = solverRtol;
 }
 
-double median(std::vector<double> values) {
-  if (values.empty()) return 0;
+/// The smallest, largest and middle values (nonempty values).
+ToleranceVector::ScaleOrder orderOf(std::vector<double> values) {
+  ToleranceVector::ScaleOrder o;
+  auto [lo, hi] = std::minmax_element(values.begin(), values.end());
+  o.smallest = *lo, o.largest = *hi;
   auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
   std::nth_element(values.begin(), middle, values.end());
-  if (values.size() % 2 == 1) return *middle;
-  double upper = *middle;
-  double lower = *std::max_element(values.begin(), middle);
-  return 0.5 * (lower + upper);
+  o.upperMiddle = o.lowerMiddle = *middle;
+  if (values.size() % 2 == 0) o.lowerMiddle = *std::max_element(values.begin(), middle);
+  return o;
 }
 
 }  // namespace
@@ -127,24 +129,29 @@ ToleranceVector buildTolerances(double rtol, std::optional<double> atol, std::sp
 }
 
 // atol_i = base * scale_i and the summary's figures of it.
+// The summary's figures are those of atol itself: the scales' order statistics times base, which
+// are the same values bit for bit (x ↦ base · x, base > 0, is monotone in floating point), unless
+// a product was replaced by the guard below — then atol's own.
 void fillAtol(ToleranceVector& t, double base) {
   t.atol.resize(t.scale.size());
+  bool guarded = false;
   for (std::size_t i = 0; i < t.scale.size(); ++i) {
     double value = base * t.scale[i];
     // Guard against overflow or underflow of the product: IDA rejects a zero or infinite weight.
-    if (!std::isfinite(value) || value <= 0) value = base;
+    if (!std::isfinite(value) || value <= 0) value = base, guarded = true;
     t.atol[i] = value;
   }
   ToleranceSummary& s = t.summary;
   s.solverRtol = t.solverRtol;
   s.atolUser = base;
   s.count = t.atol.size();
-  if (!t.atol.empty()) {
-    auto [lo, hi] = std::minmax_element(t.atol.begin(), t.atol.end());
-    s.atolMin = *lo;
-    s.atolMax = *hi;
-    s.atolMedian = median(t.atol);
-  }
+  if (t.atol.empty()) return;
+  if (!t.scaleOrder && !guarded) t.scaleOrder = orderOf(t.scale);
+  ToleranceVector::ScaleOrder o = guarded ? orderOf(t.atol) : *t.scaleOrder;
+  double by = guarded ? 1.0 : base;
+  s.atolMin = by * o.smallest;
+  s.atolMax = by * o.largest;
+  s.atolMedian = 0.5 * (by * o.lowerMiddle + by * o.upperMiddle);
 }
 
 void useCalibrated(ToleranceVector& t) {

@@ -46,6 +46,13 @@ struct ToleranceVector {
   std::vector<double> scale;  ///< scale_i: nominal_i; else automatic, or 1 when --atol was given
   double solverRtol = 0;      ///< the rtol handed to IDA: calibratedRtol(rtol) without --atol, else rtol
   ToleranceSummary summary;
+  /// The scales' smallest, largest and middle two values (one when the count is odd), found once:
+  /// atol = base · scale keeps their order, so each fillAtol reads the summary's figures off them
+  /// instead of a selection over 2·10⁶ values (buildTolerances and the restart both fill atol).
+  struct ScaleOrder {
+    double smallest = 0, largest = 0, lowerMiddle = 0, upperMiddle = 0;
+  };
+  std::optional<ScaleOrder> scaleOrder;
 };
 
 /// The rtol handed to IDA when no --atol is given, so that the global error of a run stays within

@@ -20,6 +20,12 @@
 // it. At 10⁶ masses that takes the compile from 2.3 to 1.5 s and the file → first step from 3.6
 // to 2.6 s for 2.5 % more peak memory (bench/README.md, "Heap prefaulted").
 //
+// The process's other threads (the KLU plan made ahead, ida/IdaSession.cpp; the JIT) take their
+// blocks from the same heap (one malloc arena): a thread's own arena is memory mapped afresh and
+// never prefaulted, so at 10⁶ masses the KLU plan spent half its 0.2 s faulting in new pages while
+// the solver's setup waited for it (0.09 s with one arena). The threads allocate little at the same
+// time: a lock shared among them costs nothing measurable (bench/tiering_bench.py).
+//
 // Only the time to fault pages changes; every result is the same to the bit.
 #pragma once
 
@@ -50,6 +56,7 @@ inline void reuseFreedMemory() {
 #if defined(__GLIBC__)
   if (const char* v = std::getenv("QDOT_REUSE_FREED_MEMORY"); v && std::string_view(v) == "0") return;
   mallopt(M_MMAP_MAX, 0);
+  mallopt(M_ARENA_MAX, 1);  // the other threads' blocks from this heap too (above)
   mallopt(M_TRIM_THRESHOLD, INT_MAX);  // free() trims the heap's top only beyond this (the largest value)
   if (const char* v = std::getenv("QDOT_PREFAULT_HEAP"); !v || std::string_view(v) != "0") startHeapPrefault();
 #endif
