@@ -13,7 +13,8 @@ BandLu::BandLu(int64_t n, int64_t lower, int64_t upper)
       upper_(upper),
       stride_(2 * lower + upper + 1),
       values_(static_cast<size_t>(n * stride_), 0.0),
-      pivotRow_(static_cast<size_t>(n), 0) {}
+      pivotRow_(static_cast<size_t>(n), 0),
+      inverseDiagonal_(static_cast<size_t>(n), 0.0) {}
 
 void BandLu::clear() { std::fill(values_.begin(), values_.end(), 0.0); }
 
@@ -33,8 +34,8 @@ int64_t BandLu::factor() {
     ju = std::max(ju, std::min(j + upper_ + jp, n_ - 1));
     if (jp != 0)
       for (int64_t c = j; c <= ju; ++c) std::swap(at(j + jp, c), at(j, c));
+    double inverse = inverseDiagonal_[static_cast<size_t>(j)] = 1.0 / at(j, j);
     if (below == 0) continue;
-    double inverse = 1.0 / at(j, j);
     double* multipliers = &at(j + 1, j);  // rows j + 1 … j + below of column j are contiguous
     for (int64_t i = 0; i < below; ++i) multipliers[i] *= inverse;
     for (int64_t c = j + 1; c <= ju; ++c) {
@@ -62,7 +63,7 @@ void BandLu::solve(std::span<double> b) const {
   for (int64_t j = n_ - 1; j >= 0; --j) {
     double& bj = b[static_cast<size_t>(j)];
     if (bj == 0.0) continue;
-    bj /= at(j, j);
+    bj *= inverseDiagonal_[static_cast<size_t>(j)];
     int64_t first = std::max<int64_t>(0, j - kv);
     const double* column = &at(first, j);  // rows first … j − 1 of column j are contiguous
     for (int64_t i = 0; i < j - first; ++i) b[static_cast<size_t>(first + i)] -= column[i] * bj;

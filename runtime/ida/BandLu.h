@@ -44,6 +44,7 @@ class BandLu {
   int64_t n_, lower_, upper_, stride_;
   std::vector<double> values_;
   std::vector<int64_t> pivotRow_;  ///< per column j: the row swapped with row j
+  std::vector<double> inverseDiagonal_;  ///< 1 / U(j, j): the back substitution multiplies (a division's latency is its chain's)
 };
 
 }  // namespace qdot::rt

@@ -141,6 +141,9 @@ int64_t reduceMatrix(const TwoEntryRows& rows, std::span<const int64_t> columnSt
   pivots.entryStarts.assign(1, 0);
   pivots.entryStarts.reserve(pairs + 1);
   pivots.entryRow.clear(), pivots.entryFactor.clear();
+  // J's entry count bounds the lists: reserved at the first factorization (IDA's first step), so
+  // that they are not copied as they grow; what is never written is never faulted in.
+  pivots.entryRow.reserve(rowIndices.size()), pivots.entryFactor.reserve(rowIndices.size());
   for (int64_t q = 0; q < pairs; ++q) {
     int64_t j = pivots.solvedFor(rows, q);
     for (int64_t k = columnStarts[j]; k < columnStarts[j + 1]; ++k)
