@@ -330,67 +330,113 @@ Flattener::RangeBounds Flattener::rangeBounds(const RangeExpr& r) {
 
 namespace {
 
-// A comprehension body made of numbers and the comprehension's own iterators under + − · / ^ and
-// a sign, e.g. the start values {0.01*i for i in 1:n}: the index of each name among `iterators`.
-bool isNumericBody(const ast::Expr& e, const std::vector<Iterator>& iterators) {
+// What a symbolic constant holds: −0 is 0 and every NaN one NaN (sym::Context::constant).
+double asConstant(double v) { return v == 0.0 ? 0.0 : std::isnan(v) ? std::numeric_limits<double>::quiet_NaN() : v; }
+
+struct UnaryFunction {
+  const char* name;
+  sym::Kind kind;
+};
+// The built-in functions of one argument that fold a number to a number (flatten/Builtins.cpp).
+const UnaryFunction kNumericFunctions[] = {
+    {"sin", sym::Kind::Sin},   {"cos", sym::Kind::Cos},   {"tan", sym::Kind::Tan},   {"asin", sym::Kind::Asin},
+    {"acos", sym::Kind::Acos}, {"atan", sym::Kind::Atan}, {"sinh", sym::Kind::Sinh}, {"cosh", sym::Kind::Cosh},
+    {"tanh", sym::Kind::Tanh}, {"exp", sym::Kind::Exp},   {"log", sym::Kind::Log},   {"abs", sym::Kind::Abs},
+    {"sign", sym::Kind::Sign},
+};
+
+// A comprehension body compiled once into post-order steps over a stack of numbers, then run per
+// element: numbers, the comprehension's own iterators, names that lower to a number (a constant, an
+// Integer parameter such as n), + − · / ^, a sign, and the built-in functions of one number (sin,
+// sqrt, …) — e.g. the start values {0.01*i for i in 1:n} or {sin(pi*i/(n + 1)) for i in 1:n}.
+struct NumericStep {
+  enum Op : uint8_t { Number, Iterator, Neg, Add, Sub, Mul, Div, Pow, Function } op;
+  sym::Kind function = sym::Kind::Sin;  ///< Function
+  size_t iterator = 0;                  ///< Iterator: its position among the comprehension's
+  double value = 0;                     ///< Number
+};
+
+// The steps of e, or false where e is not of that form. `numberOf(name)` lowers a name that is
+// not an iterator (nullopt: not one number); `userFunction(call)`: a call of the model's own.
+template <class NumberOf, class UserFunction>
+bool compileNumeric(const ast::Expr& e, const std::vector<Iterator>& iterators, std::vector<NumericStep>& out,
+                    NumberOf&& numberOf, UserFunction&& userFunction) {
+  auto operand = [&](const ast::Expr& x) { return compileNumeric(x, iterators, out, numberOf, userFunction); };
   switch (e.kind) {
-    case ExprKind::Number: return true;
+    case ExprKind::Number: out.push_back({NumericStep::Number, {}, 0, asConstant(cast<NumberExpr>(&e)->value)}); return true;
     case ExprKind::Name: {
       auto& parts = cast<NameExpr>(&e)->parts;
-      return parts.size() == 1 && std::any_of(iterators.begin(), iterators.end(),
-                                              [&](const Iterator& it) { return it.name == parts[0]; });
+      for (size_t k = iterators.size(); parts.size() == 1 && k-- > 0;)  // the innermost of a name wins
+        if (iterators[k].name == parts[0]) return out.push_back({NumericStep::Iterator, {}, k, 0}), true;
+      std::optional<double> v = numberOf(e);
+      if (v) out.push_back({NumericStep::Number, {}, 0, *v});
+      return v.has_value();
     }
     case ExprKind::Unary: {
       auto* u = cast<UnaryExpr>(&e);
-      return u->op != UnaryOp::Not && isNumericBody(*u->operand, iterators);
+      if (u->op == UnaryOp::Not || !operand(*u->operand)) return false;
+      if (u->op == UnaryOp::Neg) out.push_back({NumericStep::Neg});
+      return true;
     }
     case ExprKind::Binary: {
       auto* b = cast<BinaryExpr>(&e);
-      bool arithmetic = b->op == BinaryOp::Add || b->op == BinaryOp::Sub || b->op == BinaryOp::Mul ||
-                        b->op == BinaryOp::Div || b->op == BinaryOp::Pow;
-      return arithmetic && isNumericBody(*b->lhs, iterators) && isNumericBody(*b->rhs, iterators);
+      NumericStep::Op op = b->op == BinaryOp::Add   ? NumericStep::Add
+                           : b->op == BinaryOp::Sub ? NumericStep::Sub
+                           : b->op == BinaryOp::Mul ? NumericStep::Mul
+                           : b->op == BinaryOp::Div ? NumericStep::Div
+                           : b->op == BinaryOp::Pow ? NumericStep::Pow
+                                                    : NumericStep::Number;
+      if (op == NumericStep::Number || !operand(*b->lhs) || !operand(*b->rhs)) return false;
+      out.push_back({op});
+      return true;
+    }
+    case ExprKind::Call: {
+      auto* c = cast<CallExpr>(&e);
+      if (c->args.size() != 1 || !c->namedArgs.empty() || userFunction(*c)) return false;
+      std::string name = c->callee->dotted();
+      auto f = std::find_if(std::begin(kNumericFunctions), std::end(kNumericFunctions),
+                            [&](const UnaryFunction& u) { return name == u.name; });
+      if (f == std::end(kNumericFunctions) && name != "sqrt" && name != "log10") return false;
+      if (!operand(*c->args[0])) return false;
+      if (f != std::end(kNumericFunctions)) out.push_back({NumericStep::Function, f->kind});
+      else if (name == "sqrt") out.push_back({NumericStep::Number, {}, 0, 0.5}), out.push_back({NumericStep::Pow});
+      else out.push_back({NumericStep::Function, sym::Kind::Log}), out.push_back({NumericStep::Number, {}, 0, std::log(10.0)}),
+           out.push_back({NumericStep::Div});
+      return true;
     }
     default: return false;
   }
 }
 
-// What a symbolic constant holds: −0 is 0 and every NaN one NaN (sym::Context::constant).
-double asConstant(double v) { return v == 0.0 ? 0.0 : std::isnan(v) ? std::numeric_limits<double>::quiet_NaN() : v; }
-
-// The body at iterator values `at` (by position in `iterators`, the innermost of a name winning),
-// folded exactly as the symbolic constructors fold constants (symbolic/Arith.cpp): a + b, a − b
-// (0 if the same constant), a·b, a·(1/b) and powValue, with each intermediate a constant.
-double foldNumeric(const ast::Expr& e, const std::vector<Iterator>& iterators, const std::vector<double>& at) {
-  switch (e.kind) {
-    case ExprKind::Number: return asConstant(cast<NumberExpr>(&e)->value);
-    case ExprKind::Name: {
-      const std::string& name = cast<NameExpr>(&e)->parts[0];
-      for (size_t k = iterators.size(); k-- > 0;)
-        if (iterators[k].name == name) return at[k];
-      break;
+// The steps at iterator values `at` (by position), folded exactly as the symbolic constructors
+// fold constants (symbolic/Arith.cpp, Functions.cpp): a + b, a − b (0 if the same constant), a·b,
+// a·(1/b), powValue and unaryValue, each intermediate a constant; sqrt is x^0.5 and log10(x)
+// log(x)/log(10), as Builtins.cpp lowers them.
+double runNumeric(const std::vector<NumericStep>& steps, const std::vector<double>& at, std::vector<double>& stack) {
+  stack.clear();
+  auto same = [](double p, double q) { return p == q || (std::isnan(p) && std::isnan(q)); };
+  for (const NumericStep& s : steps) {
+    if (s.op == NumericStep::Number || s.op == NumericStep::Iterator) {
+      stack.push_back(s.op == NumericStep::Number ? s.value : at[s.iterator]);
+      continue;
     }
-    case ExprKind::Unary: {
-      auto* u = cast<UnaryExpr>(&e);
-      double v = foldNumeric(*u->operand, iterators, at);
-      return u->op == UnaryOp::Neg ? asConstant(-1.0 * v) : v;
+    if (s.op == NumericStep::Neg || s.op == NumericStep::Function) {
+      double& v = stack.back();
+      v = s.op == NumericStep::Neg ? asConstant(-1.0 * v) : asConstant(sym::unaryValue(s.function, v));
+      continue;
     }
-    case ExprKind::Binary: {
-      auto* b = cast<BinaryExpr>(&e);
-      double x = foldNumeric(*b->lhs, iterators, at), y = foldNumeric(*b->rhs, iterators, at);
-      auto same = [](double p, double q) { return p == q || (std::isnan(p) && std::isnan(q)); };
-      switch (b->op) {
-        case BinaryOp::Add: return x == 0 ? y : y == 0 ? x : asConstant(x + y);
-        case BinaryOp::Sub: return y == 0 ? x : same(x, y) ? 0.0 : asConstant(x - y);
-        case BinaryOp::Mul: return x == 1 ? y : y == 1 ? x : asConstant(x * y);
-        case BinaryOp::Div: return y == 1 ? x : asConstant(x * asConstant(1.0 / y));
-        case BinaryOp::Pow: return asConstant(sym::powValue(x, y));
-        default: break;
-      }
-      break;
+    double y = stack.back();
+    stack.pop_back();
+    double& x = stack.back();
+    switch (s.op) {
+      case NumericStep::Add: x = x == 0 ? y : y == 0 ? x : asConstant(x + y); break;
+      case NumericStep::Sub: x = y == 0 ? x : same(x, y) ? 0.0 : asConstant(x - y); break;
+      case NumericStep::Mul: x = x == 1 ? y : y == 1 ? x : asConstant(x * y); break;
+      case NumericStep::Div: x = y == 1 ? x : asConstant(x * asConstant(1.0 / y)); break;
+      default: x = asConstant(sym::powValue(x, y)); break;
     }
-    default: break;
   }
-  QDOT_UNREACHABLE("foldNumeric: isNumericBody admits only these");
+  return stack.back();
 }
 
 }  // namespace
@@ -400,9 +446,17 @@ double foldNumeric(const ast::Expr& e, const std::vector<Iterator>& iterators, c
 // 10⁶-element array made 2·10⁶ constants, most of the time of flattening it. The same values as
 // lowering the body per element (foldNumeric), the same checks and counts; nullopt otherwise.
 std::optional<Value> Flattener::numericComprehension(const ComprehensionExpr& e) {
-  if (!isNumericBody(*e.body, e.iterators)) return std::nullopt;
   for (const auto& it : e.iterators)
     if (!dyn_cast<RangeExpr>(it.range.get())) return std::nullopt;
+  // a name that is not an iterator is lowered once, as lowering the body per element would
+  auto numberOf = [&](const ast::Expr& name) -> std::optional<double> {
+    Value v = lower(name);
+    if (!v.shape.empty() || v.elems.size() != 1 || !v.elems[0]->isConstant()) return std::nullopt;
+    return v.elems[0]->value;
+  };
+  auto userFunction = [&](const CallExpr& c) { return m_.calls.count(&c) != 0; };
+  std::vector<NumericStep> steps;
+  if (!compileNumeric(*e.body, e.iterators, steps, numberOf, userFunction)) return std::nullopt;
   std::vector<RangeBounds> ranges;
   Value v;
   size_t count = 1;
@@ -413,9 +467,9 @@ std::optional<Value> Flattener::numericComprehension(const ComprehensionExpr& e)
   }
   std::vector<double> values;
   values.reserve(count);
-  std::vector<double> at(ranges.size());
+  std::vector<double> at(ranges.size()), stack;
   auto walk = [&](auto& self, size_t k) -> void {
-    if (k == ranges.size()) return values.push_back(foldNumeric(*e.body, e.iterators, at));
+    if (k == ranges.size()) return values.push_back(runNumeric(steps, at, stack));
     countScalars(ranges[k].count, e.iterators[k].range->range);  // as for a loop
     for (size_t i = 0; i < ranges[k].count; ++i) {
       at[k] = asConstant(ranges[k].first + static_cast<long>(i) * ranges[k].step);

@@ -70,18 +70,17 @@ uint64_t ProgramBuilder::constantBits(double v) {
 uint32_t ProgramBuilder::constant(double v) {
   uint64_t bits = constantBits(v);
   if (const uint32_t* r = knownConstant(bits)) return *r;
-  auto [pool, fresh] = pool_.try_emplace(bits, static_cast<uint32_t>(program_.constants.size()));
+  auto [index, fresh] = pool_.insert(bits, static_cast<uint32_t>(program_.constants.size()));
   if (fresh) program_.constants.push_back(std::bit_cast<double>(bits));
-  uint32_t r = emit(Op::LoadConst, 0, 0, 0, pool->second);
-  (inLoop_ ? bodyConstants_ : constants_).emplace(bits, r);
+  uint32_t r = emit(Op::LoadConst, 0, 0, 0, index);
+  (inLoop_ ? bodyConstants_ : constants_).insert(bits, r);
   return r;
 }
 
 // The register of a constant's `ldk` (outside loops the body's map is empty).
 const uint32_t* ProgramBuilder::knownConstant(uint64_t bits) const {
-  for (const auto* map : {&constants_, &bodyConstants_})
-    if (auto it = map->find(bits); it != map->end()) return &it->second;
-  return nullptr;
+  if (const uint32_t* r = constants_.find(bits)) return r;
+  return bodyConstants_.find(bits);
 }
 
 // Symbols by id, constants by value (one `ldk` per bit pattern and scope), other nodes in the memo.

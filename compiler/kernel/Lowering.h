@@ -5,8 +5,10 @@
 // what is first lowered there is per-iteration, so the memo forgets it at endLoop.
 #pragma once
 
+#include <algorithm>
+#include <cstdint>
 #include <span>
-#include <unordered_map>
+#include <vector>
 
 #include "kernel/Kernel.h"
 #include "kernel/SymbolSlots.h"
@@ -14,6 +16,56 @@
 #include "symbolic/NodeMap.h"
 
 namespace qdot::kernel {
+
+/// Constants by bit pattern → a register or pool index: open addressing with linear probing, as
+/// sym::NodeMap. A large model's start values are up to millions of distinct numbers (10⁶
+/// sin(π i/(n + 1)) in a rod): std::unordered_map's node per entry made its inserts, rehashes and
+/// destruction 0.9 s of the kernel stage there.
+class ConstantMap {
+ public:
+  /// The value stored for bits, or nullptr.
+  const uint32_t* find(uint64_t bits) const {
+    if (slots_.empty()) return nullptr;
+    for (size_t i = slotOf(bits);; i = (i + 1) & (slots_.size() - 1)) {
+      if (slots_[i].value == kEmpty) return nullptr;
+      if (slots_[i].bits == bits) return &slots_[i].value;
+    }
+  }
+  /// Inserts (bits, value) unless bits is present; the stored value and whether it was inserted.
+  std::pair<uint32_t, bool> insert(uint64_t bits, uint32_t value) {
+    if ((size_ + 1) * 4 > slots_.size() * 3) grow();
+    for (size_t i = slotOf(bits);; i = (i + 1) & (slots_.size() - 1)) {
+      if (slots_[i].value == kEmpty) {
+        slots_[i] = {bits, value};
+        ++size_;
+        return {value, true};
+      }
+      if (slots_[i].bits == bits) return {slots_[i].value, false};
+    }
+  }
+  void clear() {
+    if (size_ == 0) return;
+    std::fill(slots_.begin(), slots_.end(), Slot{});
+    size_ = 0;
+  }
+
+ private:
+  static constexpr uint32_t kEmpty = UINT32_MAX;  ///< no register or pool index is this
+  struct Slot {
+    uint64_t bits = 0;
+    uint32_t value = kEmpty;
+  };
+  size_t slotOf(uint64_t bits) const { return static_cast<size_t>((bits * 0x9E3779B97F4A7C15ull) >> 20) & (slots_.size() - 1); }
+  void grow() {
+    std::vector<Slot> old(std::max<size_t>(16, 2 * slots_.size()));
+    old.swap(slots_);
+    size_ = 0;
+    for (const Slot& s : old)
+      if (s.value != kEmpty) insert(s.bits, s.value);
+  }
+  std::vector<Slot> slots_;
+  size_t size_ = 0;
+};
 
 class ProgramBuilder {
  public:
@@ -102,13 +154,13 @@ class ProgramBuilder {
   SymbolSlots<sym::Expr> temporaries_{nullptr};
   SymbolSlots<Load> loads_{kNoLoad};
   const UnknownSymbols* unknowns_ = nullptr;          // loads of y and y' not in loads_
-  std::unordered_map<uint64_t, uint32_t> constants_;  // bit pattern -> register
-  std::unordered_map<uint64_t, uint32_t> pool_;       // bit pattern -> index in the pool
+  ConstantMap constants_;  // bit pattern -> register
+  ConstantMap pool_;       // bit pattern -> index in the pool
   // The open loop body's own values, forgotten at endLoop: nodes, constants, and the symbols'
   // registers it set (symbol id, register before), undone in reverse.
   bool inLoop_ = false;
   sym::NodeMap<uint32_t> bodyMemo_;
-  std::unordered_map<uint64_t, uint32_t> bodyConstants_;
+  ConstantMap bodyConstants_;
   std::vector<std::pair<uint32_t, uint32_t>> bodySymbols_;
   std::vector<UnboundUse> unbound_;
   std::vector<Frame> frames_;  // lower()'s stack, kept to reuse its storage

@@ -53,6 +53,8 @@ double applyKind(Kind k, double a, double b, double c) {
   return nan;
 }
 
+double unaryValue(Kind k, double x) { return applyKind(k, x); }
+
 Evaluator::Evaluator(std::span<const Expr> roots) {
   PostOrder po = postOrder(roots);
   nodes_ = std::move(po.order);

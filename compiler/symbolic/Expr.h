@@ -267,6 +267,10 @@ double evaluate(Expr e, std::span<const double> values);
 /// x^2, x^-1, x^0.5): for a caller that folds numbers itself and must agree bit for bit.
 double powValue(double base, double exponent);
 
+/// f(x) for a unary kind (Sin … Sign) as Context::unary folds a constant argument (before the
+/// constant's own normalization: −0 → 0, one NaN): for callers that fold numbers themselves.
+double unaryValue(Kind k, double x);
+
 /// Evaluates many roots sharing one memo (each node computed once).
 void evaluate(std::span<const Expr> roots, std::span<const double> values, std::span<double> out);
 

@@ -66,7 +66,7 @@ end Shapes;)", "", driver::Stage::Dae));
 // numeric body without symbolic intermediates).
 std::vector<double> startValues(const std::string& body) {
   driver::Compilation c;
-  std::string text = "model S\n  coordinate Real x[7, 5](start = {" + body +
+  std::string text = "model S\n  parameter Integer n = 7;\n  constant Real c = 0.7;\n  coordinate Real x[7, 5](start = {" + body +
                      " for i in 1:7, j in 1:5});\nmechanics\n  kinetic = sum(der(x[i, j])^2 for i in 1:7, j in 1:5);\nend S;\n";
   EXPECT_TRUE(driver::compileSource(c, "start.qd", text, "", driver::Stage::Flatten)) << text;
   std::vector<double> values;
@@ -76,14 +76,18 @@ std::vector<double> startValues(const std::string& body) {
   return values;
 }
 
-// Reference: the same body lowered symbolically, element by element (adding sin(0), which folds
-// to the constant 0, keeps the value and takes the body out of the numeric path): the values must
-// be the same bit for bit, non-finite ones included.
+// Reference: the same body lowered symbolically, element by element (`if i > 0 then body else 0`
+// folds to the body's value, and an if-expression takes it out of the numeric path): the values
+// must be the same bit for bit, non-finite ones included. The numeric path also takes names that
+// are numbers (an Integer parameter, a constant) and the built-in functions of one number.
 TEST(Comprehension, ANumericBodyGivesTheValuesOfItsSymbolicLowering) {
   for (const char* body : {"0.01*i", "i/3 - j/7", "1/(i - 2)", "(i - 2)/(i - 2)", "-(i - 0.3*j)^2/7 + i*0.1",
-                           "2^(i/3) - j", "i*0.1 - 0.3", "+i - -j", "(1e308*i)*(1e10*j)", "i - i + 0.5/j"}) {
+                           "2^(i/3) - j", "i*0.1 - 0.3", "+i - -j", "(1e308*i)*(1e10*j)", "i - i + 0.5/j",
+                           "sin(3.14159265358979*i/(n + 1))*cos(c*j)", "exp(-i/n) + log(j) - log10(i*j)",
+                           "sqrt(i - 3) + abs(j - 2.5)*sign(i - 4)", "tanh(c*i) + atan(j) + asin(1/i) + acos(1/j)",
+                           "sinh(i/7)/cosh(j/5) + tan(c) + sin(0)"}) {
     std::vector<double> numeric = startValues(body);
-    std::vector<double> symbolic = startValues(std::string("(") + body + ") + sin(0)");
+    std::vector<double> symbolic = startValues(std::string("if i > 0 then (") + body + ") else 0");
     ASSERT_EQ(numeric.size(), 35u) << body;
     ASSERT_EQ(symbolic.size(), 35u) << body;
     for (size_t k = 0; k < numeric.size(); ++k) {
