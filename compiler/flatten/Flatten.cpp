@@ -204,6 +204,47 @@ int Flattener::derivativeVariable(int var, SourceRange where) {
   return addDerivative(var, derRole, ctx_.symbol(derivativeName_));
 }
 
+// derivativeVariable for every element, with the symbols of a batch made by one Context::symbols
+// (the name table reserved and probed ahead): a template's der(T[i]) over 10⁶ unknowns made them
+// one name at a time, 0.24 s of the heat rod's flatten. Same names, ids and variable indices.
+std::vector<Expr> Flattener::derivativeSymbols(std::span<const Expr> elements, SourceRange where) {
+  constexpr int kQueued = -2;  ///< a variable's `derivative` while its name waits in the batch
+  std::vector<int> vars(elements.size()), queued;
+  NameBuffer names;
+  auto make = [&] {
+    std::vector<Expr> symbols = ctx_.symbols(names.views());
+    for (size_t k = 0; k < queued.size(); ++k) {
+      out_.variables[queued[k]].derivative = -1;
+      VarRole role = out_.variables[queued[k]].role;
+      addDerivative(queued[k], role == VarRole::Coordinate ? VarRole::Velocity
+                               : role == VarRole::Velocity ? VarRole::Acceleration
+                                                           : VarRole::Derivative,
+                    symbols[k]);
+    }
+    queued.clear();
+    names.clear();
+  };
+  for (size_t k = 0; k < elements.size(); ++k) {
+    int var = vars[k] = out_.variableOf(elements[k]);
+    if (out_.variables[var].derivative != -1) continue;  // made, or queued already
+    VarRole role = out_.variables[var].role;
+    if (role != VarRole::Coordinate && role != VarRole::Velocity && role != VarRole::Unknown) {
+      make();
+      derivativeVariable(var, where);  // reports why it has none
+      continue;
+    }
+    out_.variables[var].derivative = kQueued;
+    queued.push_back(var);
+    names.chars.append("der(").append(out_.variables[var].name) += ')';
+    names.finish();
+    if (names.full()) make();
+  }
+  make();
+  std::vector<Expr> rates(elements.size());
+  for (size_t k = 0; k < elements.size(); ++k) rates[k] = out_.variables[out_.variables[vars[k]].derivative].symbol;
+  return rates;
+}
+
 int Flattener::addDerivative(int var, VarRole role, Expr symbol) {
   Variable d{.role = role, .symbol = symbol, .declRange = out_.variables[var].declRange};
   d.derivativeOf = var;

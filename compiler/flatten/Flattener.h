@@ -296,6 +296,9 @@ class Flattener {
   int addVariable(Variable v);
   void reserveVariables(size_t count);
   int derivativeVariable(int var, SourceRange where);
+  /// The der() symbols of variables (coordinates, velocities or unknowns, in order): those not made
+  /// yet as derivativeVariable makes them, in the same order, their names a batch at a time.
+  std::vector<sym::Expr> derivativeSymbols(std::span<const sym::Expr> elements, SourceRange where);
   int addDerivative(int var, VarRole role, sym::Expr symbol);
   void addCoordinateDerivatives(const Value& coordinates);
   bool addCoordinateDerivativeArrays(const Value& coordinates);

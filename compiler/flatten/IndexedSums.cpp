@@ -840,8 +840,7 @@ Expr Flattener::rateOfRelative(const RelativeElement& rel) {
     }
     if (constant) return ctx_.zero();
     if (!moving && !unknowns) throw NotATemplate{};
-    rates.reserve(a.elements.size());
-    for (Expr e : a.elements) rates.push_back(out_.variables[derivativeVariable(out_.variableOf(e), derivativeSite_)].symbol);
+    rates = derivativeSymbols(a.elements, derivativeSite_);
     int id = static_cast<int>(out_.patterns->arrays.size());
     out_.patterns->arrays.push_back({"der(" + a.name + ")", a.shape, std::move(rates)});
     out_.patterns->arrays[rel.array].derivative = id;
