@@ -25,6 +25,12 @@ const UnaryMath kUnaryMath[] = {
 
 }  // namespace
 
+std::optional<Kind> unaryMathKind(std::string_view name) {
+  for (const auto& u : kUnaryMath)
+    if (name == u.name) return u.kind;
+  return std::nullopt;
+}
+
 // d/dt with one memo for the whole model. A symbol's rate is asked once, when a derivative first
 // reaches it: time → 1, parameters (and non-variables) → 0, any other variable → its der() variable,
 // created on demand (an error at `where` if it cannot have one; it is then asked again next time).
@@ -52,8 +58,7 @@ Value Flattener::lowerCall(const CallExpr& e) {
     return v;
   }
   if (auto call = m_.calls.find(&e); call != m_.calls.end()) return lowerFunctionCall(call->second);
-  for (const auto& u : kUnaryMath)
-    if (name == u.name) return mapUnary(arg(0), u.kind);
+  if (std::optional<Kind> k = unaryMathKind(name)) return mapUnary(arg(0), *k);
   if (name == "sqrt" || name == "log10") {
     Value v = arg(0);
     for (Expr& x : v.elems)

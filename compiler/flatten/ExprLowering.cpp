@@ -333,18 +333,6 @@ namespace {
 // What a symbolic constant holds: −0 is 0 and every NaN one NaN (sym::Context::constant).
 double asConstant(double v) { return v == 0.0 ? 0.0 : std::isnan(v) ? std::numeric_limits<double>::quiet_NaN() : v; }
 
-struct UnaryFunction {
-  const char* name;
-  sym::Kind kind;
-};
-// The built-in functions of one argument that fold a number to a number (flatten/Builtins.cpp).
-const UnaryFunction kNumericFunctions[] = {
-    {"sin", sym::Kind::Sin},   {"cos", sym::Kind::Cos},   {"tan", sym::Kind::Tan},   {"asin", sym::Kind::Asin},
-    {"acos", sym::Kind::Acos}, {"atan", sym::Kind::Atan}, {"sinh", sym::Kind::Sinh}, {"cosh", sym::Kind::Cosh},
-    {"tanh", sym::Kind::Tanh}, {"exp", sym::Kind::Exp},   {"log", sym::Kind::Log},   {"abs", sym::Kind::Abs},
-    {"sign", sym::Kind::Sign},
-};
-
 // A comprehension body compiled once into post-order steps over a stack of numbers, then run per
 // element: numbers, the comprehension's own iterators, names that lower to a number (a constant, an
 // Integer parameter such as n), + − · / ^, a sign, and the built-in functions of one number (sin,
@@ -394,11 +382,10 @@ bool compileNumeric(const ast::Expr& e, const std::vector<Iterator>& iterators, 
       auto* c = cast<CallExpr>(&e);
       if (c->args.size() != 1 || !c->namedArgs.empty() || userFunction(*c)) return false;
       std::string name = c->callee->dotted();
-      auto f = std::find_if(std::begin(kNumericFunctions), std::end(kNumericFunctions),
-                            [&](const UnaryFunction& u) { return name == u.name; });
-      if (f == std::end(kNumericFunctions) && name != "sqrt" && name != "log10") return false;
+      std::optional<sym::Kind> f = unaryMathKind(name);
+      if (!f && name != "sqrt" && name != "log10") return false;
       if (!operand(*c->args[0])) return false;
-      if (f != std::end(kNumericFunctions)) out.push_back({NumericStep::Function, f->kind});
+      if (f) out.push_back({NumericStep::Function, *f});
       else if (name == "sqrt") out.push_back({NumericStep::Number, {}, 0, 0.5}), out.push_back({NumericStep::Pow});
       else out.push_back({NumericStep::Function, sym::Kind::Log}), out.push_back({NumericStep::Number, {}, 0, std::log(10.0)}),
            out.push_back({NumericStep::Div});

@@ -189,13 +189,18 @@ int Flattener::addVariable(Variable v) {
 
 // der(x) of a variable: created on first use. A coordinate's velocity and a velocity's
 // acceleration have their own roles; a second derivative of any other unknown is refused.
+// The role of der(v) for a variable of role r: Time where v has none.
+static VarRole derivativeRole(VarRole r) {
+  return r == VarRole::Coordinate ? VarRole::Velocity
+         : r == VarRole::Velocity ? VarRole::Acceleration
+         : r == VarRole::Unknown  ? VarRole::Derivative
+                                  : VarRole::Time;
+}
+
 int Flattener::derivativeVariable(int var, SourceRange where) {
   if (out_.variables[var].derivative >= 0) return out_.variables[var].derivative;
   VarRole role = out_.variables[var].role;
-  VarRole derRole = role == VarRole::Coordinate ? VarRole::Velocity
-                    : role == VarRole::Velocity ? VarRole::Acceleration
-                    : role == VarRole::Unknown  ? VarRole::Derivative
-                                                : VarRole::Time;
+  VarRole derRole = derivativeRole(role);
   if (derRole == VarRole::Time)
     fail(where, DiagCode::E0311,
          "cannot take the derivative of '" + std::string(out_.variables[var].name) + "' (a " + roleName(role) + ")",
@@ -215,11 +220,7 @@ std::vector<Expr> Flattener::derivativeSymbols(std::span<const Expr> elements, S
     std::vector<Expr> symbols = ctx_.symbols(names.views());
     for (size_t k = 0; k < queued.size(); ++k) {
       out_.variables[queued[k]].derivative = -1;
-      VarRole role = out_.variables[queued[k]].role;
-      addDerivative(queued[k], role == VarRole::Coordinate ? VarRole::Velocity
-                               : role == VarRole::Velocity ? VarRole::Acceleration
-                                                           : VarRole::Derivative,
-                    symbols[k]);
+      addDerivative(queued[k], derivativeRole(out_.variables[queued[k]].role), symbols[k]);
     }
     queued.clear();
     names.clear();
@@ -227,8 +228,7 @@ std::vector<Expr> Flattener::derivativeSymbols(std::span<const Expr> elements, S
   for (size_t k = 0; k < elements.size(); ++k) {
     int var = vars[k] = out_.variableOf(elements[k]);
     if (out_.variables[var].derivative != -1) continue;  // made, or queued already
-    VarRole role = out_.variables[var].role;
-    if (role != VarRole::Coordinate && role != VarRole::Velocity && role != VarRole::Unknown) {
+    if (derivativeRole(out_.variables[var].role) == VarRole::Time) {
       make();
       derivativeVariable(var, where);  // reports why it has none
       continue;

@@ -9,6 +9,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <string_view>
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>
@@ -186,6 +187,9 @@ struct Summand {
   bool negated;
   std::vector<Factor> factors;
 };
+
+/// The kind of a built-in math function of one argument (sin … sign; Builtins.cpp), or nullopt.
+std::optional<sym::Kind> unaryMathKind(std::string_view name);
 
 class Flattener {
  public:
