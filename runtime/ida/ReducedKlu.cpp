@@ -25,8 +25,8 @@ struct BandedS {
 };
 
 // A band LU computes every entry inside its band, KLU only the nonzeros and their fill: the band
-// is used when at least a third of it is S's entries (a chain's tridiagonal S: all of it). Whole
-// chain matrices (bandwidth 3, 8 entries in a band of 7 per column, but U's fill makes it 10)
+// is used when at least a third of it is S's entries (a chain's tridiagonal S: all of it). A whole
+// chain matrix (half bandwidth 3: 4 entries per column in a band of 7, 10 rows with U's fill)
 // measured slower with SUNDIALS' band LU than with KLU (bench/README.md, session 20).
 constexpr int64_t kBandFullness = 3;
 
