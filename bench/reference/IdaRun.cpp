@@ -9,6 +9,7 @@
 #include "arkode/StartLinearization.h"
 #include "ida/DiagonalRates.h"
 #include "ida/KluOrdering.h"
+#include "ida/SerialVectorOps.h"
 #include "sim/ProcessClock.h"
 
 #include <ida/ida.h>
@@ -143,6 +144,10 @@ Integrator::Integrator(const ReferenceModel& model, const RunSettings& settings)
   yp_ = created(N_VNew_Serial(n_, context_), "N_VNew_Serial");
   id_ = created(N_VNew_Serial(n_, context_), "N_VNew_Serial");
   atol_ = created(N_VNew_Serial(n_, context_), "N_VNew_Serial");
+  // The same vector operations as qdot's runtime (ida/SerialVectorOps.h: Debian's SUNDIALS is built
+  // without optimization), so that the comparison measures qdot, not how the library was built;
+  // QDOT_SUNDIALS_VECTOR_OPS=1 runs both on SUNDIALS' own.
+  for (N_Vector v : {y_, yp_, id_, atol_}) rt::useOptimizedSerialOps(v);
   std::vector<double> y0 = model.startValues();
   std::copy(y0.begin(), y0.end(), data(y_));
   N_VConst(0.0, yp_);

@@ -20,6 +20,7 @@
 #include "arkode/ExplicitForm.h"
 #include "arkode/StartLinearization.h"
 #include "ida/ModelCheck.h"
+#include "ida/SerialVectorOps.h"
 
 namespace qdot::rt {
 namespace {
@@ -204,6 +205,7 @@ void ArkodeSession::Impl::setup() {
   yp = N_VNew_Serial(n, context);
   atol = N_VNew_Serial(n, context);
   if (!y || !yp || !atol) throw IdaError("N_VNew_Serial failed (out of memory)", options.t0);
+  for (N_Vector v : {y, yp, atol}) useOptimizedSerialOps(v);  // ida/SerialVectorOps.h: Debian's are unoptimized
   loadInitialValues();
   createIntegrator();
   attachLinearSolver();

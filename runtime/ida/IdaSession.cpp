@@ -27,6 +27,7 @@
 #include "ida/KluOrdering.h"
 #include "ida/ModelCheck.h"
 #include "ida/ReducedKlu.h"
+#include "ida/SerialVectorOps.h"
 #include "qdot/model_description.hpp"
 
 namespace qdot::rt {
@@ -383,19 +384,27 @@ void IdaSession::Impl::orderAhead() {
 }
 
 void IdaSession::Impl::createVectors() {
+  // Every vector with the operations compiled here (ida/SerialVectorOps.h: Debian's are unoptimized);
+  // IDA clones its own from y, operations table included.
+  auto vector = [&] {
+    N_Vector v = created(N_VNew_Serial(n, context), "N_VNew_Serial");
+    useOptimizedSerialOps(v);
+    return v;
+  };
   if (dummies || options.observeSteps) {
-    yStep = created(N_VNew_Serial(n, context), "N_VNew_Serial");
-    ypStep = created(N_VNew_Serial(n, context), "N_VNew_Serial");
+    yStep = vector();
+    ypStep = vector();
   }
   y = created(N_VNew_Serial(n, context), "N_VNew_Serial");
-  // IDA clones its vectors from y: with the fused operations a linear combination of k vectors
-  // (the predictor, the error estimate) is one pass over memory instead of k (N_VScale, then a
-  // N_VLinearSum per vector), which a large model's steps are bound by. The same sums in the same
+  // With the fused operations a linear combination of k vectors (the predictor, the error
+  // estimate) is one call instead of a N_VScale and k - 1 N_VLinearSum, and one pass over memory
+  // (SerialVectorOps.cpp), which a large model's steps are bound by. The same sums in the same
   // order: every result is the same to the bit.
   N_VEnableFusedOps_Serial(y, SUNTRUE);
-  yp = created(N_VNew_Serial(n, context), "N_VNew_Serial");
-  id = created(N_VNew_Serial(n, context), "N_VNew_Serial");
-  atol = created(N_VNew_Serial(n, context), "N_VNew_Serial");
+  useOptimizedSerialOps(y);
+  yp = vector();
+  id = vector();
+  atol = vector();
   for (uint32_t i = 0; i < n; ++i)
     data(id)[i] = model.isDifferential[i] ? 1.0 : 0.0;
 }
