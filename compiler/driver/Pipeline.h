@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <thread>
 #include <vector>
 
 #include "ast/AST.h"
@@ -106,6 +107,8 @@ struct Compilation {
   Stage reached = Stage::Parse;  ///< the last stage that ran without errors (valid once `ok`)
   bool ok = false;               ///< every stage run so far succeeded
   std::string internalError;     ///< why a backend failed on valid kernels (a bug, not a model error)
+  /// Destroys what releaseStages lets go of on another thread (last: joined before the rest goes).
+  std::jthread releasing;
 
   Compilation() = default;
   Compilation(const Compilation&) = delete;
