@@ -124,6 +124,13 @@ class ChunkedVector {
     chunks_[size_ >> kBits][size_ & kMask] = v;
     ++size_;
   }
+  /// Room for `count` more elements, left unwritten: each is then written through at(), by any
+  /// thread as long as no two write the same element.
+  void grow(size_t count) {
+    size_ += count;
+    while (chunks_.size() << kBits < size_) chunks_.push_back(std::make_unique_for_overwrite<T[]>(kChunk));
+  }
+  T& at(size_t i) { return chunks_[i >> kBits][i & kMask]; }
 
  private:
   static constexpr size_t kBits = 12, kChunk = size_t{1} << kBits, kMask = kChunk - 1;

@@ -268,6 +268,32 @@ TEST(Storage, SymbolArraysAreFoundByName) {
   EXPECT_TRUE(ctx.symbolArray("e", std::vector<int>{0}).empty());
 }
 
+// A large array is made in two halves on two threads (Context::symbolArray): every element still
+// has its own id in order, its own node, and the name the flattener gives it, written out here
+// independently (a 2-D shape whose halves meet inside a row, subscripts gaining digits on both
+// sides of the cut), and is found by that name.
+TEST(Storage, ALargeSymbolArrayIsMadeInTwoHalvesWithEveryName) {
+  Context ctx;
+  Expr before = ctx.symbol("a");
+  std::vector<int> shape{1001, 131};  // 131 131 elements: the cut at 65 565 = row 501, column 66
+  std::vector<Expr> m = ctx.symbolArray("der(M", shape, ")");
+  ASSERT_EQ(m.size(), 1001u * 131u);
+  size_t k = 0, wrong = 0;
+  for (int i = 1; i <= shape[0]; ++i)
+    for (int j = 1; j <= shape[1]; ++j, ++k) {
+      std::string name = "der(M[" + std::to_string(i) + "," + std::to_string(j) + "])";
+      bool right = m[k]->isSymbol() && m[k]->symbolId == before->symbolId + 1 + k && ctx.symbolName(m[k]) == name &&
+                   (k % 997 != 0 || ctx.findSymbol(name) == m[k]);  // the lookup on a sample
+      if (!right && wrong++ < 5) ADD_FAILURE() << "element " << k << " (" << name << ") is " << ctx.symbolName(m[k]);
+    }
+  EXPECT_EQ(wrong, 0u);
+  EXPECT_EQ(ctx.symbolCount(), 1 + m.size());
+  EXPECT_EQ(ctx.symbol("b")->symbolId, 1 + m.size());  // the next symbol after the block
+  std::vector<Expr> rates = ctx.symbolArrayAround(m[0], "$der(", ")");
+  EXPECT_EQ(ctx.symbolName(rates[65565]), "$der(der(M[501,66]))");
+  EXPECT_EQ(ctx.symbolName(rates.back()), "$der(der(M[1001,131]))");
+}
+
 // wholeSymbolArrayAt recognises an array's symbols only whole and in order, and symbolArrayAround
 // makes the array of the names around them (der(q[i]) for q[i]) as a block of the same shape.
 TEST(Storage, ASymbolArrayIsRecognisedWholeAndWrapped) {
