@@ -15,9 +15,9 @@
 #include <type_traits>
 #include <utility>
 #include <stdexcept>
-#include <thread>
 
 #include "support/Assert.h"
+#include "support/TwoHalves.h"
 #include "symbolic/ContextImpl.h"
 
 namespace qdot::sym {
@@ -413,16 +413,8 @@ std::vector<Expr> Context::symbolArray(std::string_view prefix, std::span<const 
       out[k] = s;
     }
   };
-  // A large block is written at 1-2 GB/s by one thread (a 10⁶-element array of symbols is 0.05 s
-  // of the compile): the second half on the core the single-threaded compile leaves idle.
-  constexpr size_t kTwoThreadsFrom = size_t{1} << 16;
-  if (count >= kTwoThreadsFrom) {
-    std::thread secondHalf(make, count / 2, count);
-    make(0, count / 2);
-    secondHalf.join();
-  } else {
-    make(0, count);
-  }
+  // A 10⁶-element array of symbols is 0.05 s of the compile on one thread.
+  inTwoHalves(count, make);
   im.nodeCount += count;
   return out;
 }
