@@ -6,6 +6,9 @@
 #include <ostream>
 #include <thread>
 
+#include <fmt/format.h>
+
+#include "kernel/Kernel.h"
 #include "vm/Vm.h"
 
 namespace qdot::driver {
@@ -65,7 +68,7 @@ rt::TierTrigger policyTrigger(const CompileEstimate& estimate) {
 // Wraps out.model (the VM) in a tiered model whose second tier the JIT compiles in the background
 // once `trigger` says so (at once without one). The compile thread holds the kernels and its own
 // copy of the sources, so nothing it reads can go away while it runs.
-void addBackgroundJit(const Compilation& c, rt::TierTrigger trigger, RunnableModel& out) {
+void addBackgroundJit(const Compilation& c, rt::TierTrigger trigger, RunnableModel& out, double compileSeconds = 0) {
   llvmbackend::JitOptions options = backgroundJitOptions();
   auto sources = std::make_shared<const SourceManager>(c.sources);
   out.what = "bytecode then llvm";
@@ -78,7 +81,7 @@ void addBackgroundJit(const Compilation& c, rt::TierTrigger trigger, RunnableMod
         if (!model) jit->error = model.error();
         return model ? std::move(model).value() : ModelPtr();
       },
-      std::move(trigger));
+      std::move(trigger), compileSeconds);
 }
 
 }  // namespace
@@ -86,6 +89,18 @@ void addBackgroundJit(const Compilation& c, rt::TierTrigger trigger, RunnableMod
 RunnableModel makeRunnableModel(Compilation& c, Backend backend, bool invariants) {
   RunnableModel out;
   auto t0 = std::chrono::steady_clock::now();
+  if (backend == Backend::Tiered) {
+    out.jitEstimate = estimateCompile(*c.kernels, backgroundJitOptions(), backgroundJitOptions().threads);
+    double vmCall = vmCallSeconds(*c.kernels);
+    if (compileFirst(out.jitEstimate, vmCall)) {
+      backend = Backend::Native;
+      out.decision = fmt::format(
+          "tiering: compiled before the run: a residual call on the VM (~{:.3g} ms, {} kernel instructions) is "
+          "expected to take longer than the whole compile (~{:.3g} ms of CPU)\n",
+          vmCall * 1e3, kernel::executedInstructions(c.kernels->program(ModelProgram::Residual)),
+          out.jitEstimate.cpuSeconds * 1e3);
+    }
+  }
   if (backend == Backend::Native) {
     if (compileNativeFirst(c, invariants, out)) {
       out.codegenSeconds = secondsSince(t0);
@@ -94,8 +109,9 @@ RunnableModel makeRunnableModel(Compilation& c, Backend backend, bool invariants
     out.warning = "the LLVM JIT failed (" + out.jit->error + "); running on the bytecode VM instead";
   }
   if (loadBytecode(c, out) && backend == Backend::Tiered) {
-    out.jitEstimate = estimateCompile(*c.kernels, backgroundJitOptions(), backgroundJitOptions().threads);
-    addBackgroundJit(c, policyTrigger(out.jitEstimate), out);
+    // The estimate errs long (TieringPolicy.cpp): a call waits for native code only when even
+    // that is shorter than a call on the VM.
+    addBackgroundJit(c, policyTrigger(out.jitEstimate), out, out.jitEstimate.cpuSeconds);
   } else if (out.model && backend == Backend::Background) {
     addBackgroundJit(c, {}, out);
   }
@@ -133,6 +149,7 @@ void printTieringDecision(const RunnableModel& m, const rt::TierReport& tiers, s
 }  // namespace
 
 std::optional<rt::TierReport> reportTiers(const RunnableModel& m, bool stats, std::ostream& log) {
+  if (stats) log << m.decision;
   std::optional<rt::TierReport> tiers = rt::tierReport(m.model.get());
   if (!tiers) return tiers;
   const JitOutcome& jit = *m.jit;
@@ -143,7 +160,10 @@ std::optional<rt::TierReport> reportTiers(const RunnableModel& m, bool stats, st
   if (tiers->ready) {
     log << "jit: native code ready " << tiers->readySeconds * 1e3 << " ms after the VM started; "
         << tiers->firstTierCalls << " residual/Jacobian calls on the VM, " << tiers->secondTierCalls
-        << " on native code\n";
+        << " on native code";
+    if (tiers->callsThatWaited > 0)
+      log << " (" << tiers->callsThatWaited << " waited for it: a call on the VM took longer than what was left of the compile)";
+    log << "\n";
     printJitStats(jit.stats, log);
   } else if (tiers->started && !failed) {
     log << "jit: the run ended before the native code was ready (all " << tiers->firstTierCalls

@@ -39,6 +39,7 @@ struct RunnableModel {
   std::string error;    ///< why there is no model (a bug: valid kernels always load)
   std::string warning;  ///< e.g. the JIT failed and the VM runs instead
   CompileEstimate jitEstimate;  ///< Backend::Tiered: the JIT work the policy weighs
+  std::string decision;  ///< Backend::Tiered compiled first (TieringPolicy.h): why (--stats)
 };
 
 /// Makes the runnable model of a compilation that reached Stage::Kernel (continuing it to the

@@ -10,6 +10,10 @@
 //     to the run: the payback factor keeps a run from ever losing more than a fraction of what it
 //     gains, and a run whose model calls are cheap (most of its time in the linear solver, or short)
 //     never compiles. Why and when is printed by --stats (reportTiers).
+//   Before the run: a model whose every residual call on the VM is expected to take longer than
+//     the whole compile (vmCallSeconds >= the estimate: the spring chain from about 10⁶ masses)
+//     is compiled first, as --jit-wait does: the VM would only make the run wait, and the bytecode
+//     module cost memory.
 #pragma once
 
 #include <cstddef>
@@ -52,6 +56,15 @@ struct TierVerdict {
   /// Decided on one call's cost: native code saves more of a single call than the compile takes.
   bool oneCallPays = false;
 };
+
+/// What one residual call of `k` is expected to take on the VM: its executed instructions
+/// (kernel::executedInstructions) at a rate below the VM's measured one, so that compileFirst
+/// errs towards the VM.
+double vmCallSeconds(const kernel::KernelModule& k);
+
+/// Whether native code is compiled before the run (above): one VM call is expected to cost more
+/// than the whole compile.
+bool compileFirst(const CompileEstimate& e, double vmCallSeconds);
 
 /// The decision on what the run has shown so far (`seen`), for a compile of `compileSeconds`.
 TierVerdict decideTiering(const rt::TierObservation& seen, double compileSeconds, const TieringRule& rule = {});

@@ -53,12 +53,13 @@ struct Tiered : QdotModel {
   TierCompiler compile;
   TierTrigger trigger;
   std::thread compiler;
-  Clock::time_point created = Clock::now();
+  double compileSeconds = 0;  // expected (0: unknown)
+  Clock::time_point created = Clock::now(), compileStarted;
   std::atomic<bool> done{false};  // the compile thread has finished, or never started (release)
   std::atomic<double> readySeconds{0};
   // The solver thread's own: which tier answered last, what the first tier has cost, the horizon.
   const QdotModel* last = nullptr;
-  uint64_t firstCalls = 0, secondCalls = 0;
+  uint64_t firstCalls = 0, secondCalls = 0, callsThatWaited = 0;
   double firstSeconds = 0;
   uint64_t timeEvery = 1, untilTimed = 1;  // calls per timed call, calls until the next one
   bool hasHorizon = false;
@@ -83,6 +84,7 @@ struct Tiered : QdotModel {
 
   void startCompile() {
     started = true;
+    compileStarted = Clock::now();
     done.store(false, std::memory_order_release);
     compiler = std::thread([this] {
       ModelPtr model = compile(cancel);
@@ -92,7 +94,16 @@ struct Tiered : QdotModel {
         second.store(model.release(), std::memory_order_release);
       }
       done.store(true, std::memory_order_release);
+      done.notify_all();
     });
+  }
+
+  // Whether the next call is answered sooner by waiting for the compile than by the first tier:
+  // its calls so far took longer on average than what the estimate leaves of the compile.
+  bool worthWaiting() const {
+    if (!started || compileSeconds <= 0 || firstCalls == 0 || done.load(std::memory_order_acquire)) return false;
+    double left = compileSeconds - secondsBetween(compileStarted, Clock::now());
+    return firstSeconds / double(firstCalls) > left;
   }
 
   // Asks the trigger every kAskEvery first-tier calls (every call, if they are long) until it
@@ -131,6 +142,10 @@ struct Tiered : QdotModel {
   // A residual or Jacobian call: the second tier once published, else the first, timed.
   template <class Call>
   int hot(Call call) {
+    if (worthWaiting()) {
+      ++callsThatWaited;
+      done.wait(false, std::memory_order_acquire);
+    }
     if (const QdotModel* m = second.load(std::memory_order_acquire)) {
       ++secondCalls;
       last = m;
@@ -198,8 +213,9 @@ void destroy(QdotModel* s) {
 
 }  // namespace
 
-ModelPtr createTieredModel(ModelPtr first, TierCompiler compile, TierTrigger trigger) {
+ModelPtr createTieredModel(ModelPtr first, TierCompiler compile, TierTrigger trigger, double compileSeconds) {
   auto* t = new Tiered();
+  t->compileSeconds = compileSeconds;
   static_cast<QdotModel&>(*t) = *first;  // sizes, names, pattern: the first tier's
   t->first = std::move(first);
   t->parameters = parameters, t->initialValues = initialValues, t->fixedStarts = fixedStarts;
@@ -231,6 +247,7 @@ std::optional<TierReport> tierReport(const QdotModel* model) {
   r.readySeconds = r.ready ? t.readySeconds.load() : 0;
   r.firstTierCalls = t.firstCalls;
   r.secondTierCalls = t.secondCalls;
+  r.callsThatWaited = t.callsThatWaited;
   r.firstTierSeconds = t.firstSeconds;
   return r;
 }

@@ -115,5 +115,31 @@ TEST(TieringPolicy, TheEstimateFollowsTheCompilePlan) {
   EXPECT_LT(plain.cpuSeconds, e.cpuSeconds);
 }
 
+// A residual call's VM time is estimated from the instructions it executes: the chain's loops run
+// once per mass, so it grows with n while the compile does not; a model is compiled before the
+// run exactly when one VM call is expected to cost at least the whole compile.
+TEST(TieringPolicy, AModelWhoseVmCallOutweighsTheCompileIsCompiledFirst) {
+  auto vmCall = [](int n, CompileEstimate* estimate) {
+    Compilation c;
+    c.options.keepLoops = c.options.rerollRows = true;  // as qdot run compiles
+    EXPECT_TRUE(compileSource(c, "spring_chain.qd", test::readSource("examples/vibration/spring_chain.qd"), "", Stage::Check));
+    std::vector<std::string> assignments{"n=" + std::to_string(n)};
+    EXPECT_EQ(takeStructuralParameters(c, assignments), "");
+    EXPECT_TRUE(continueTo(c, Stage::Kernel));
+    llvmbackend::JitOptions hot;
+    hot.compiledPrograms = llvmbackend::programBit(ModelProgram::Residual) | llvmbackend::programBit(ModelProgram::Jacobian);
+    *estimate = estimateCompile(*c.kernels, hot, 1);
+    return vmCallSeconds(*c.kernels);
+  };
+  CompileEstimate small, large;
+  double atSmall = vmCall(2000, &small), atLarge = vmCall(20000, &large);
+  EXPECT_NEAR(atLarge / atSmall, 10.0, 0.1);              // linear in n
+  EXPECT_EQ(small.cpuSeconds, large.cpuSeconds);          // the loops compile once, whatever n
+  EXPECT_FALSE(compileFirst(small, atSmall));             // ~0.1 ms a call against a ~25 ms compile
+  EXPECT_TRUE(compileFirst(small, small.cpuSeconds));
+  EXPECT_FALSE(compileFirst(small, 0.99 * small.cpuSeconds));
+  EXPECT_FALSE(compileFirst(CompileEstimate{}, 1.0));     // nothing to compile: nothing first
+}
+
 }  // namespace
 }  // namespace qdot::driver

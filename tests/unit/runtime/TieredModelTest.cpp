@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include "sim/TieredModel.h"
@@ -20,6 +21,7 @@ struct StandIn : QdotModel {
   double value = 0;
   std::string error;
   std::atomic<int>* destroyed = nullptr;
+  int callMilliseconds = 0;  ///< how long a residual call takes
 };
 
 ModelPtr standIn(double value, std::atomic<int>* destroyed) {
@@ -30,6 +32,7 @@ ModelPtr standIn(double value, std::atomic<int>* destroyed) {
   m->error = "tier " + std::to_string(static_cast<int>(value));
   m->destroyed = destroyed;
   m->residual = [](const QdotModel* s, double, const double*, const double*, const double*, double* F) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<const StandIn*>(s)->callMilliseconds));
     F[0] = static_cast<const StandIn*>(s)->value;
     return 0;
   };
@@ -92,6 +95,31 @@ TEST(TieredModel, RunsTheFirstTierUntilTheSecondIsReadyThenTheSecond) {
   EXPECT_GE(report->secondTierCalls, 2u);
   tiered.reset();
   EXPECT_EQ(destroyed.load(), 2);
+}
+
+// With the compile's expected duration, a call waits for the second tier when the first tier's
+// calls take longer than what is left of the compile (100 ms calls, a 200 ms compile expected to
+// take 150 ms: after the first call 50 ms are left); without it, or with calls shorter than that,
+// the first tier answers while the compile runs.
+TEST(TieredModel, ACallLongerThanTheRestOfTheCompileWaitsForTheSecondTier) {
+  for (auto [callMs, expected, waits] : {std::tuple{100, 0.15, true}, std::tuple{100, 0.0, false}, std::tuple{5, 0.15, false}}) {
+    std::atomic<int> destroyed{0};
+    ModelPtr first = standIn(1.0, &destroyed);
+    static_cast<StandIn*>(first.get())->callMilliseconds = callMs;
+    ModelPtr tiered = createTieredModel(
+        std::move(first),
+        [&](const std::atomic<bool>&) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(200));
+          return standIn(2.0, &destroyed);
+        },
+        {}, expected);
+    QdotModel* m = tiered.get();
+    EXPECT_EQ(residualOf(m), 1.0);  // nothing to go by before the first call
+    EXPECT_EQ(residualOf(m), waits ? 2.0 : 1.0) << callMs << " ms calls, " << expected << " s expected";
+    EXPECT_EQ(tierReport(m)->callsThatWaited, waits ? 1u : 0u);
+    tiered.reset();
+    EXPECT_EQ(destroyed.load(), 2);
+  }
 }
 
 TEST(TieredModel, DestroyCancelsACompileStillRunning) {
