@@ -62,12 +62,18 @@ TierVerdict decideTiering(const rt::TierObservation& seen, double compileSeconds
   // Nothing to extrapolate from yet (the start values are still being solved, or no horizon).
   if (seen.recentProgress <= 0 || seen.elapsedSeconds <= 0) return v;
   v.remainingVmSeconds = seen.recentFirstTierSeconds * (1 - seen.progress) / seen.recentProgress;
+  // A core the run has left idle takes the compile without taking the solver's time, at an idle
+  // machine's speed (the estimate was measured under load): the compile is expected to take
+  // idleCompileShare of it, and the saving need only repay that once.
+  bool idle = seen.idleCores >= rule.idleCore;
+  double compile = idle ? rule.idleCompileShare * compileSeconds : compileSeconds;
+  v.payback = idle ? 1 : rule.payback;
   // While it compiles the run stays on the VM, spending the share of its time it spent so far.
-  double duringCompile = compileSeconds * std::min(1.0, seen.firstTierSeconds / seen.elapsedSeconds);
+  double duringCompile = compile * std::min(1.0, seen.firstTierSeconds / seen.elapsedSeconds);
   double afterCompile = std::max(0.0, v.remainingVmSeconds - duringCompile);
   v.savingSeconds = afterCompile * (1 - 1 / rule.nativeSpeedup);
   v.compile = seen.progress >= rule.minProgress && seen.firstTierSeconds >= rule.minObserved * compileSeconds &&
-              v.savingSeconds >= rule.payback * compileSeconds;
+              v.savingSeconds >= v.payback * compile;
   return v;
 }
 

@@ -47,6 +47,12 @@ struct TieringRule {
   double payback = 2;        ///< the projected saving must exceed this many compile CPU times
   double minObserved = 0.1;  ///< decide only once the VM calls took this fraction of the compile
   double minProgress = 0.01;  ///< and the run got this far (past the solver's first, tiny steps)
+  /// Idle cores on average (TierObservation::idleCores) from which the compile is taken to cost
+  /// the run nothing: it runs on a core the run leaves idle, at an idle machine's speed, taking
+  /// `idleCompileShare` of the estimate (which was measured under load: car_axis 19 ms of CPU
+  /// against 40 ms estimated), and the saving need only repay that once, not `payback` times.
+  double idleCore = 0.75;
+  double idleCompileShare = 0.5;
 };
 
 struct TierVerdict {
@@ -55,6 +61,7 @@ struct TierVerdict {
   double savingSeconds = 0;       ///< what native code would save of it, after the compile
   /// Decided on one call's cost: native code saves more of a single call than the compile takes.
   bool oneCallPays = false;
+  double payback = 0;  ///< the payback asked for (rule.payback, or 1 with an idle core)
 };
 
 /// What one residual call of `k` is expected to take on the VM: its executed instructions

@@ -38,6 +38,9 @@ struct TierObservation {
   /// the progress, and a few calls alone say little on a busy machine.
   double recentProgress = 0;
   double recentFirstTierSeconds = 0;
+  /// The machine's idle cores on average since the tiered model was created (Linux: /proc/stat,
+  /// read at most every few milliseconds); -1 where unknown or too early to tell.
+  double idleCores = -1;
 };
 
 /// Decides, on the solver thread, whether the compile starts now. Asked every few residual calls

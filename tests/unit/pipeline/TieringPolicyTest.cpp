@@ -96,6 +96,23 @@ TEST(TieringPolicy, TheRecentRateCountsNotTheRateSinceTheStart) {
   EXPECT_FALSE(decideTiering(seen, 0.2).compile);  // what is left after the compile, x 3/4, < 2 x 0.2 s
 }
 
+// With a core left idle through the run so far, the compile takes nothing from the solver and runs
+// at an idle machine's speed (half the estimate): the saving need only repay that once. Unknown
+// (-1) or a busy machine keeps the estimate and the payback of 2.
+TEST(TieringPolicy, AnIdleCoreAsksTheSavingToRepayAnIdleMachinesCompileOnce) {
+  rt::TierObservation seen = steadyRun(0.1, 0.2, 0.1);  // 0.9 s of VM calls to come, half of the run on the VM
+  EXPECT_FALSE(decideTiering(seen, 0.4).compile);        // (0.9 - 0.4/2) x 3/4 = 0.525 < 2 x 0.4
+  seen.idleCores = 0.9;
+  TierVerdict v = decideTiering(seen, 0.4);  // a 0.2 s compile: (0.9 - 0.1) x 3/4 = 0.6 >= 0.2
+  EXPECT_TRUE(v.compile);
+  EXPECT_EQ(v.payback, 1.0);
+  EXPECT_NEAR(v.savingSeconds, 0.6, 1e-12);
+  EXPECT_FALSE(decideTiering(seen, 1.4).compile);  // 0.7 s: (0.9 - 0.35) x 3/4 = 0.4125 < 0.7
+  seen.idleCores = 0.5;
+  EXPECT_FALSE(decideTiering(seen, 0.4).compile);
+  EXPECT_EQ(decideTiering(seen, 0.4).payback, 2.0);
+}
+
 TEST(TieringPolicy, TheEstimateFollowsTheCompilePlan) {
   Compilation c;
   ASSERT_TRUE(compileSource(c, "nlink.qd", test::readSource("examples/pendulum/nlink.qd"), "", Stage::Kernel));
