@@ -141,8 +141,12 @@ struct Tiered : QdotModel {
 
   // Whether the next call is answered sooner by waiting for the compile than by the first tier:
   // its calls so far took longer on average than what the estimate leaves of the compile.
+  // Calls shorter than kAskEachCallAbove never wait (nor read the clock for it): a compile is
+  // longer than that until its last moment, and they are the hot path of small models.
   bool worthWaiting() const {
-    if (!started || compileSeconds <= 0 || firstCalls == 0 || done.load(std::memory_order_acquire)) return false;
+    if (!started || compileSeconds <= 0 || firstSeconds < kAskEachCallAbove * double(firstCalls) || firstCalls == 0 ||
+        done.load(std::memory_order_acquire))
+      return false;
     double left = compileSeconds - secondsBetween(compileStarted, Clock::now());
     return firstSeconds / double(firstCalls) > left;
   }
