@@ -17,6 +17,7 @@
 #include "dae/TemplateOde.h"
 #include "flatten/FlatPrinter.h"
 #include "sim/Names.h"
+#include "support/TwoHalves.h"
 #include "syntax/Parser.h"
 
 namespace qdot::driver {
@@ -128,11 +129,24 @@ std::string whyScalar(const flat::FlatModel& m, const CompileOptions& o, const s
     return "an initial equation (" + flat::lineOf(sm, m.initialEquations[0].origin.range) + ", …) is not a state's start value";
   std::vector<char> isDefined(m.variables.size(), 0);
   for (int z : defined ? *defined : std::vector<int>{}) isDefined[z] = 1;
-  for (size_t v = 0; v < m.variables.size(); ++v) {
+  // The first variable that keeps the model scalar, searched in two halves (3·10⁶ variables at
+  // 10⁶ masses: one pass over them was 17 ms).
+  auto keepsScalar = [&](const flat::Variable& var, size_t v) {
+    return var.alias || var.role == flat::VarRole::Derivative || (var.role == flat::VarRole::Unknown && !isDefined[v]);
+  };
+  size_t firstFound[2] = {m.variables.size(), m.variables.size()};
+  inTwoHalves(m.variables.size(), [&](size_t begin, size_t end) {
+    for (size_t v = begin; v < end; ++v)
+      if (keepsScalar(m.variables[v], v)) {
+        firstFound[begin == 0 ? 0 : 1] = v;
+        break;
+      }
+  });
+  if (size_t v = std::min(firstFound[0], firstFound[1]); v < m.variables.size()) {
     const flat::Variable& var = m.variables[v];
     if (var.alias) return "'" + std::string(var.name) + "' is an alias (connections and alias equations work on scalars)";
     if (var.role == flat::VarRole::Derivative) return "'" + std::string(var.name) + "' is the rate of an unknown that is not a coordinate";
-    if (var.role == flat::VarRole::Unknown && !isDefined[v]) return "'" + std::string(var.name) + "' is an unknown no equation defines explicitly";
+    return "'" + std::string(var.name) + "' is an unknown no equation defines explicitly";
   }
   std::string unread;
   for (const auto& sum : m.indexedSums) {

@@ -289,6 +289,8 @@ bool Flattener::addCoordinateDerivativeArrays(const Value& coordinates) {
     if (out_.variables[out_.variableOf(x)].derivative >= 0) return false;
   std::vector<Expr> velocities = ctx_.symbolArrayAround(coordinates.elems[0], "der(", ")");
   std::vector<Expr> accelerations = ctx_.symbolArrayAround(coordinates.elems[0], "der(der(", "))");
+  reserveSymbolSlots(accelerations);  // made last: the largest ids
+  reserveVariables(2 * count);
   for (size_t k = 0; k < count; ++k) {
     int var = out_.variableOf(coordinates.elems[k]);
     addDerivative(addDerivative(var, VarRole::Velocity, velocities[k]), VarRole::Acceleration, accelerations[k]);
@@ -468,7 +470,18 @@ Value Flattener::createDeclaration(const Declaration& d, const sema::ModelSymbol
 // copy the whole vector for every declaration); a large array then fills it without regrowing.
 void Flattener::reserveVariables(size_t count) {
   std::vector<Variable>& vars = out_.variables;
-  if (vars.size() + count > vars.capacity()) vars.reserve(std::max(vars.size() + count, 2 * vars.capacity()));
+  if (vars.size() + count <= vars.capacity()) return;
+  size_t capacity = std::max(vars.size() + count, 2 * vars.capacity());
+  vars.reserve(capacity);  // and the tables kept by variable (10⁶ masses: their regrowth was 20 ms)
+  varOwner_.reserve(capacity);
+  connectorPotential_.reserve(capacity);
+}
+
+// symbolToVariable up to a block's last symbol at once (addVariable grew it one id at a time).
+void Flattener::reserveSymbolSlots(std::span<const Expr> symbols) {
+  uint32_t last = 0;
+  for (Expr s : {symbols.front(), symbols.back()}) last = std::max(last, s->symbolId);
+  if (out_.symbolToVariable.size() <= last) out_.symbolToVariable.resize(last + 1, -1);
 }
 
 // Once per declaration: lowering it again after a dependency was resolved finds them here.
@@ -496,6 +509,7 @@ Value Flattener::variablesFor(const Declaration& d, const std::vector<int>& shap
   // An array's elements are one block of symbols (Context::symbolArray): no name is hashed.
   std::string name = cur_->prefix() + d.name;
   std::vector<Expr> symbols = shape.empty() ? std::vector<Expr>{ctx_.symbol(name)} : ctx_.symbolArray(name, shape);
+  if (!symbols.empty()) reserveSymbolSlots(symbols);
   for (Expr symbol : symbols) {
     addVariable({.role = role, .symbol = symbol, .declRange = where, .attributes = attributes});
     v.elems.push_back(symbol);

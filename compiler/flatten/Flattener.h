@@ -8,6 +8,7 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <span>
 #include <string>
 #include <string_view>
 #include <unordered_map>
@@ -299,6 +300,7 @@ class Flattener {
   bool fixedPotential(int var);
   int addVariable(Variable v);
   void reserveVariables(size_t count);
+  void reserveSymbolSlots(std::span<const sym::Expr> symbols);
   int derivativeVariable(int var, SourceRange where);
   /// The der() symbols of variables (coordinates, velocities or unknowns, in order): those not made
   /// yet as derivativeVariable makes them, in the same order, their names a batch at a time.

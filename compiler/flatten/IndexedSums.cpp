@@ -828,7 +828,7 @@ Expr Flattener::rateOfRelative(const RelativeElement& rel) {
   ArrayVariable& a = out_.patterns->arrays[rel.array];
   if (a.derivative < 0) {
     std::vector<Expr> rates;
-    bool constant = true, moving = true, unknowns = ratesOfUnknowns_;
+    bool constant = true, moving = true, unknowns = ratesOfUnknowns_, made = true;
     for (Expr e : a.elements) {
       int var = out_.variableOf(e);
       VarRole role = var >= 0 ? out_.variables[var].role : VarRole::Parameter;
@@ -837,10 +837,16 @@ Expr Flattener::rateOfRelative(const RelativeElement& rel) {
       constant &= isConstant;
       moving &= isMoving;
       unknowns &= var >= 0 && role == VarRole::Unknown;
+      made &= var >= 0 && out_.variables[var].derivative >= 0;
     }
     if (constant) return ctx_.zero();
     if (!moving && !unknowns) throw NotATemplate{};
-    rates = derivativeSymbols(a.elements, derivativeSite_);
+    if (made) {  // a coordinate array's velocities and accelerations exist already: read them
+      rates.reserve(a.elements.size());
+      for (Expr e : a.elements) rates.push_back(out_.variables[out_.variables[out_.variableOf(e)].derivative].symbol);
+    } else {
+      rates = derivativeSymbols(a.elements, derivativeSite_);
+    }
     int id = static_cast<int>(out_.patterns->arrays.size());
     out_.patterns->arrays.push_back({"der(" + a.name + ")", a.shape, std::move(rates)});
     out_.patterns->arrays[rel.array].derivative = id;

@@ -382,7 +382,7 @@ std::span<const double> ArkodeSession::yp() const { return {data(impl_->yp), imp
 std::span<const double> ArkodeSession::parameters() const { return impl_->p; }
 const QdotModel& ArkodeSession::model() const { return impl_->model; }
 SolverStats ArkodeSession::stats() const { return impl_->stats(); }
-const ToleranceSummary& ArkodeSession::tolerances() const { return impl_->tolerances.summary; }
+const ToleranceSummary& ArkodeSession::tolerances() const { return summarize(impl_->tolerances); }
 std::span<const double> ArkodeSession::absoluteTolerances() const { return impl_->tolerances.atol; }
 LinearSolverKind ArkodeSession::linearSolver() const { return impl_->kind; }
 const std::vector<std::string>& ArkodeSession::warnings() const { return impl_->warnings; }

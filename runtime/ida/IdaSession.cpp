@@ -891,7 +891,7 @@ std::span<const double> IdaSession::yp() const {
 std::span<const double> IdaSession::parameters() const { return impl_->p; }
 const QdotModel& IdaSession::model() const { return impl_->model; }
 SolverStats IdaSession::stats() const { return impl_->stats(); }
-const ToleranceSummary& IdaSession::tolerances() const { return impl_->tolerances.summary; }
+const ToleranceSummary& IdaSession::tolerances() const { return summarize(impl_->tolerances); }
 std::span<const double> IdaSession::absoluteTolerances() const { return impl_->tolerances.atol; }
 LinearSolverKind IdaSession::linearSolver() const { return impl_->kind; }
 bool IdaSession::computedInitialValues() const { return impl_->initialValues != InitialValueMethod::AsGiven; }

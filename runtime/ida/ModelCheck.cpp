@@ -6,6 +6,8 @@
 
 #include <algorithm>
 
+#include "qdot/csc_pattern.hpp"
+
 namespace qdot::rt {
 namespace {
 
@@ -31,6 +33,7 @@ std::optional<std::string> checkColumn(const QdotModel& m, uint32_t column) {
   int32_t begin = m.jacobianColumnStarts[column];
   int32_t end = m.jacobianColumnStarts[column + 1];
   if (begin > end) return fmt::format("Jacobian column {} has a negative length", column);
+  if (static_cast<uint32_t>(end) > m.jacobianNonzeros) return fmt::format("Jacobian column {} ends past the nonzeros", column);
   for (int32_t k = begin; k < end; ++k) {
     int32_t row = m.jacobianRowIndices[k];
     if (row < 0 || static_cast<uint32_t>(row) >= std::max(m.nResiduals, m.nVariables))
@@ -51,9 +54,12 @@ std::optional<std::string> checkPattern(const QdotModel& m) {
   if (m.nResiduals != 0 && m.nResiduals < m.nVariables) return "it has fewer residuals than variables";
   if (m.nResiduals > m.nVariables + m.nInitialRows && (m.nDerivativeLinks == 0 || m.nDifferentiatedEquations == 0))
     return "it has more residuals than variables but no index reduction tables";
-  for (uint32_t column = 0; column < m.nVariables; ++column)
+  if (cscPatternValid(m.jacobianColumnStarts, m.jacobianRowIndices, m.nVariables, m.jacobianNonzeros,
+                      std::max(m.nResiduals, m.nVariables)))
+    return std::nullopt;
+  for (uint32_t column = 0; column < m.nVariables; ++column)  // which problem, for the message
     if (auto problem = checkColumn(m, column)) return problem;
-  return std::nullopt;
+  return "its Jacobian column starts exceed the nonzeros";
 }
 
 }  // namespace

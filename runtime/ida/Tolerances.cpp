@@ -18,17 +18,6 @@ double magnitude(double y0, double nominal) {
   return std::isfinite(y0) ? std::abs(y0) : 0.0;
 }
 
-/// Largest magnitude over the unknowns of one kind (kind < 0: all unknowns).
-double largestMagnitude(std::span<const double> y0, std::span<const double> nominal,
-                        std::span<const int32_t> isDifferential, int kind) {
-  double largest = 0;
-  for (std::size_t i = 0; i < y0.size(); ++i) {
-    if (kind >= 0 && (isDifferential[i] != 0) != (kind != 0)) continue;
-    largest = std::max(largest, magnitude(y0[i], nominal[i]));
-  }
-  return std::isfinite(largest) ? largest : 0.0;
-}
-
 double floorFor(double kindLargest, double allLargest) {
   if (allLargest <= 0) return 1.0;
   // A kind whose values are all zero or negligible (roundoff such as 1e-30 left by IDACalcIC)
@@ -48,21 +37,23 @@ void rescale(ToleranceVector& t, double solverRtol) {
   ToleranceSummary& s = t.summary;
   double factor = solverRtol / t.solverRtol;
   for (double& a : t.atol) a *= factor;
-  s.atolMin *= factor, s.atolMedian *= factor, s.atolMax *= factor;
+  t.summarized = false;
   s.atolUser = t.solverRtol = s.solverRtol = solverRtol;
 }
 
-/// The smallest, largest and middle values (nonempty values).
-ToleranceVector::ScaleOrder orderOf(std::vector<double> values) {
-  ToleranceVector::ScaleOrder o;
-  auto [lo, hi] = std::minmax_element(values.begin(), values.end());
-  o.smallest = *lo, o.largest = *hi;
-  auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  o.upperMiddle = o.lowerMiddle = *middle;
-  if (values.size() % 2 == 0) o.lowerMiddle = *std::max_element(values.begin(), middle);
-  return o;
+/// The largest magnitude of the algebraic (kind 0) and of the differential (kind 1) unknowns, in one
+/// pass (the largest of all is the larger of the two).
+std::pair<double, double> largestMagnitudes(std::span<const double> y0, std::span<const double> nominal,
+                                            std::span<const int32_t> isDifferential) {
+  double largest[2] = {0, 0};
+  for (std::size_t i = 0; i < y0.size(); ++i) {
+    double& l = largest[isDifferential[i] != 0 ? 1 : 0];
+    l = std::max(l, magnitude(y0[i], nominal[i]));
+  }
+  return {largest[0], largest[1]};
 }
+
+double finiteOrZero(double v) { return std::isfinite(v) ? v : 0.0; }
 
 }  // namespace
 
@@ -87,9 +78,9 @@ std::vector<double> toleranceScales(std::span<const double> y, std::span<const d
                                     std::span<const int32_t> isDifferential, std::span<const double> start,
                                     const TimeScale& timeScale) {
   if (start.empty()) start = y;
-  double all = largestMagnitude(start, nominal, isDifferential, -1);
-  double floors[2] = {floorFor(largestMagnitude(start, nominal, isDifferential, 0), all),
-                      floorFor(largestMagnitude(start, nominal, isDifferential, 1), all)};
+  auto [algebraic, differential] = largestMagnitudes(start, nominal, isDifferential);
+  double all = finiteOrZero(std::max(algebraic, differential));
+  double floors[2] = {floorFor(finiteOrZero(algebraic), all), floorFor(finiteOrZero(differential), all)};
   std::vector<double> scales(y.size());
   for (std::size_t i = 0; i < y.size(); ++i) {
     if (hasNominal(nominal[i])) {
@@ -128,30 +119,38 @@ ToleranceVector buildTolerances(double rtol, std::optional<double> atol, std::sp
   return result;
 }
 
-// atol_i = base * scale_i and the summary's figures of it.
-// The summary's figures are those of atol itself: the scales' order statistics times base, which
-// are the same values bit for bit (x ↦ base · x, base > 0, is monotone in floating point), unless
-// a product was replaced by the guard below — then atol's own.
+// atol_i = base * scale_i. The summary's figures of it (smallest, median, largest: a selection over
+// 2·10⁶ values at 10⁶ masses, 15-25 ms) wait until someone asks for them (summarize), after the run.
 void fillAtol(ToleranceVector& t, double base) {
   t.atol.resize(t.scale.size());
-  bool guarded = false;
   for (std::size_t i = 0; i < t.scale.size(); ++i) {
     double value = base * t.scale[i];
     // Guard against overflow or underflow of the product: IDA rejects a zero or infinite weight.
-    if (!std::isfinite(value) || value <= 0) value = base, guarded = true;
+    if (!std::isfinite(value) || value <= 0) value = base;
     t.atol[i] = value;
   }
   ToleranceSummary& s = t.summary;
   s.solverRtol = t.solverRtol;
   s.atolUser = base;
   s.count = t.atol.size();
-  if (t.atol.empty()) return;
-  if (!t.scaleOrder && !guarded) t.scaleOrder = orderOf(t.scale);
-  ToleranceVector::ScaleOrder o = guarded ? orderOf(t.atol) : *t.scaleOrder;
-  double by = guarded ? 1.0 : base;
-  s.atolMin = by * o.smallest;
-  s.atolMax = by * o.largest;
-  s.atolMedian = 0.5 * (by * o.lowerMiddle + by * o.upperMiddle);
+  t.summarized = false;
+}
+
+const ToleranceSummary& summarize(ToleranceVector& t) {
+  if (t.summarized) return t.summary;
+  ToleranceSummary& s = t.summary;
+  s.atolMin = s.atolMedian = s.atolMax = 0;
+  if (!t.atol.empty()) {
+    std::vector<double> values = t.atol;
+    auto [lo, hi] = std::minmax_element(values.begin(), values.end());
+    s.atolMin = *lo, s.atolMax = *hi;
+    auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+    std::nth_element(values.begin(), middle, values.end());
+    double upper = *middle, lower = values.size() % 2 == 0 ? *std::max_element(values.begin(), middle) : upper;
+    s.atolMedian = 0.5 * (lower + upper);
+  }
+  t.summarized = true;
+  return s;
 }
 
 void useCalibrated(ToleranceVector& t) {

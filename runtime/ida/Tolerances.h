@@ -20,7 +20,7 @@ struct ToleranceSummary {
   double solverRtol = 0;      ///< the rtol handed to IDA (calibrated without --atol)
   double atolUser = 0;        ///< the user's --atol, or solverRtol when none was given (the automatic base)
   bool atolGiven = false;     ///< whether --atol was given (then atol_i = atol, or atol * nominal_i)
-  double atolMin = 0;         ///< smallest atol_i
+  double atolMin = 0;         ///< smallest atol_i (these three: filled by summarize)
   double atolMedian = 0;      ///< median atol_i
   double atolMax = 0;         ///< largest atol_i
   std::size_t count = 0;      ///< number of unknowns
@@ -46,14 +46,12 @@ struct ToleranceVector {
   std::vector<double> scale;  ///< scale_i: nominal_i; else automatic, or 1 when --atol was given
   double solverRtol = 0;      ///< the rtol handed to IDA: calibratedRtol(rtol) without --atol, else rtol
   ToleranceSummary summary;
-  /// The scales' smallest, largest and middle two values (one when the count is odd), found once:
-  /// atol = base · scale keeps their order, so each fillAtol reads the summary's figures off them
-  /// instead of a selection over 2·10⁶ values (buildTolerances and the restart both fill atol).
-  struct ScaleOrder {
-    double smallest = 0, largest = 0, lowerMiddle = 0, upperMiddle = 0;
-  };
-  std::optional<ScaleOrder> scaleOrder;
+  bool summarized = false;  ///< summary.atolMin, atolMedian, atolMax are those of atol (see summarize)
 };
+
+/// The summary with its figures of the atol in use (min, median, max), computed when first asked
+/// for after atol changed: only `--stats` reads them, after the run.
+const ToleranceSummary& summarize(ToleranceVector& t);
 
 /// The rtol handed to IDA when no --atol is given, so that the global error of a run stays within
 /// 10x of rtol: IDA controls the error of each step, and the error at the end of a run grows as
@@ -115,7 +113,7 @@ void useAsGiven(ToleranceVector& tolerances);
 void useCalibrated(ToleranceVector& tolerances);
 
 /// atol_i = base * scale_i (base where the product is not a positive finite number) and the
-/// summary's solverRtol, atolUser, count, minimum, median and maximum of them.
+/// summary's solverRtol, atolUser and count (its minimum, median and maximum: summarize).
 void fillAtol(ToleranceVector& tolerances, double base);
 
 /// Recalibrates automatic tolerances for another method (no-op with --atol): solverRtol =

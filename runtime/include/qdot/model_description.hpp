@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "qdot/csc_pattern.hpp"
 #include "qdot/programs.hpp"
 
 namespace qdot {
@@ -77,8 +78,10 @@ struct ModelDescription {
     if (starts.size() != n + 1 || starts[0] != 0 || static_cast<size_t>(starts[n]) != rows.size())
       return "Jacobian column starts are inconsistent";
     size_t rowsEnd = residualCount();
-    for (size_t j = 0; j < n; ++j) {
+    if (cscPatternValid(starts.data(), rows.data(), n, rows.size(), rowsEnd)) return "";
+    for (size_t j = 0; j < n; ++j) {  // which problem, for the message
       if (starts[j] > starts[j + 1]) return "Jacobian column starts decrease";
+      if (static_cast<size_t>(starts[j + 1]) > rows.size()) return "Jacobian column starts exceed the nonzeros";
       for (int32_t k = starts[j]; k < starts[j + 1]; ++k)
         if (rows[k] < 0 || static_cast<size_t>(rows[k]) >= rowsEnd || (k > starts[j] && rows[k] <= rows[k - 1]))
           return "Jacobian row indices out of range or not ascending in column " + std::to_string(j);
