@@ -10,18 +10,21 @@ std::optional<DiagonalRates> diagonalRates(std::span<const Index> columnStarts, 
   size_t n = columnStarts.size() - 1;
   constexpr uint32_t kNone = UINT32_MAX;
   DiagonalRates r{std::vector<uint32_t>(n, kNone), std::vector<double>(n, 0.0)};
-  std::vector<uint32_t> columnOf(n, kNone);
   for (size_t c = 0; c < n; ++c)
     for (Index k = columnStarts[c]; k < columnStarts[c + 1]; ++k) {
       if (at0[k] + 1.0 == at0[k] || !std::isfinite(at0[k])) return std::nullopt;  // the entry is unseen
       double entry = at1[k] - at0[k];
       if (entry == 0) continue;
-      auto row = static_cast<uint32_t>(rowIndices[k]);
-      if (r.rowOf[c] != kNone || columnOf[row] != kNone || !std::isfinite(entry)) return std::nullopt;
-      r.rowOf[c] = row, columnOf[row] = static_cast<uint32_t>(c), r.d[c] = entry;
+      if (r.rowOf[c] != kNone || !std::isfinite(entry)) return std::nullopt;
+      r.rowOf[c] = static_cast<uint32_t>(rowIndices[k]), r.d[c] = entry;
     }
-  for (uint32_t row : r.rowOf)
-    if (row == kNone) return std::nullopt;
+  // one entry per row too: the columns' rows are all different (a pass after, rather than a
+  // lookup per entry)
+  std::vector<char> taken(n, 0);
+  for (uint32_t row : r.rowOf) {
+    if (row >= n || taken[row]) return std::nullopt;  // kNone: a column without its entry
+    taken[row] = 1;
+  }
   return r;
 }
 
