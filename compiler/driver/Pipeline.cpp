@@ -17,7 +17,7 @@
 #include "dae/TemplateOde.h"
 #include "flatten/FlatPrinter.h"
 #include "sim/Names.h"
-#include "support/TwoHalves.h"
+#include "qdot/two_halves.hpp"
 #include "syntax/Parser.h"
 
 namespace qdot::driver {

@@ -17,7 +17,7 @@
 #include <stdexcept>
 
 #include "support/Assert.h"
-#include "support/TwoHalves.h"
+#include "qdot/two_halves.hpp"
 #include "symbolic/ContextImpl.h"
 
 namespace qdot::sym {

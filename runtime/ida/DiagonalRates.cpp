@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "qdot/two_halves.hpp"
+
 namespace qdot::rt {
 
 template <class Index>
@@ -10,14 +12,23 @@ std::optional<DiagonalRates> diagonalRates(std::span<const Index> columnStarts, 
   size_t n = columnStarts.size() - 1;
   constexpr uint32_t kNone = UINT32_MAX;
   DiagonalRates r{std::vector<uint32_t>(n, kNone), std::vector<double>(n, 0.0)};
-  for (size_t c = 0; c < n; ++c)
+  // Column c's one nonzero entry of J(cj = 1) − J(cj = 0), if it has exactly one and sees every entry.
+  auto columnEntry = [&](size_t c) {
     for (Index k = columnStarts[c]; k < columnStarts[c + 1]; ++k) {
-      if (at0[k] + 1.0 == at0[k] || !std::isfinite(at0[k])) return std::nullopt;  // the entry is unseen
+      if (at0[k] + 1.0 == at0[k] || !std::isfinite(at0[k])) return false;  // the entry is unseen
       double entry = at1[k] - at0[k];
       if (entry == 0) continue;
-      if (r.rowOf[c] != kNone || !std::isfinite(entry)) return std::nullopt;
+      if (r.rowOf[c] != kNone || !std::isfinite(entry)) return false;
       r.rowOf[c] = static_cast<uint32_t>(rowIndices[k]), r.d[c] = entry;
     }
+    return true;
+  };
+  bool found[2] = {true, true};  // per half of the columns (two threads from 65 536 columns)
+  inTwoHalves(n, [&](size_t first, size_t last) {
+    bool& good = found[first == 0 ? 0 : 1];
+    for (size_t c = first; c < last && good; ++c) good = columnEntry(c);
+  });
+  if (!found[0] || !found[1]) return std::nullopt;
   // one entry per row too: the columns' rows are all different (a pass after, rather than a
   // lookup per entry)
   std::vector<char> taken(n, 0);

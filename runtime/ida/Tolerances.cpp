@@ -8,6 +8,8 @@
 #include <cmath>
 #include <unordered_map>
 
+#include "qdot/two_halves.hpp"
+
 namespace qdot::rt {
 namespace {
 
@@ -45,12 +47,15 @@ void rescale(ToleranceVector& t, double solverRtol) {
 /// pass (the largest of all is the larger of the two).
 std::pair<double, double> largestMagnitudes(std::span<const double> y0, std::span<const double> nominal,
                                             std::span<const int32_t> isDifferential) {
-  double largest[2] = {0, 0};
-  for (std::size_t i = 0; i < y0.size(); ++i) {
-    double& l = largest[isDifferential[i] != 0 ? 1 : 0];
-    l = std::max(l, magnitude(y0[i], nominal[i]));
-  }
-  return {largest[0], largest[1]};
+  double largest[2][2] = {{0, 0}, {0, 0}};  // per half (two threads from 65 536 unknowns: a maximum is exact in any order)
+  inTwoHalves(y0.size(), [&](size_t first, size_t last) {
+    double* l = largest[first == 0 ? 0 : 1];
+    for (std::size_t i = first; i < last; ++i) {
+      double& kind = l[isDifferential[i] != 0 ? 1 : 0];
+      kind = std::max(kind, magnitude(y0[i], nominal[i]));
+    }
+  });
+  return {std::max(largest[0][0], largest[1][0]), std::max(largest[0][1], largest[1][1])};
 }
 
 double finiteOrZero(double v) { return std::isfinite(v) ? v : 0.0; }
@@ -82,13 +87,10 @@ std::vector<double> toleranceScales(std::span<const double> y, std::span<const d
   double all = finiteOrZero(std::max(algebraic, differential));
   double floors[2] = {floorFor(finiteOrZero(algebraic), all), floorFor(finiteOrZero(differential), all)};
   std::vector<double> scales(y.size());
-  for (std::size_t i = 0; i < y.size(); ++i) {
-    if (hasNominal(nominal[i])) {
-      scales[i] = nominal[i];
-    } else {
-      scales[i] = std::max(magnitude(y[i], 0.0), floors[isDifferential[i] != 0 ? 1 : 0]);
-    }
-  }
+  inTwoHalves(y.size(), [&](size_t first, size_t last) {
+    for (std::size_t i = first; i < last; ++i)
+      scales[i] = hasNominal(nominal[i]) ? nominal[i] : std::max(magnitude(y[i], 0.0), floors[isDifferential[i] != 0 ? 1 : 0]);
+  });
   // Velocities after their positions: scale_q is final above (a position is never itself der(...)
   // of another unknown in a mechanics model; if it were, it keeps the value computed above).
   for (std::size_t i = 0; i < y.size(); ++i)
@@ -123,12 +125,14 @@ ToleranceVector buildTolerances(double rtol, std::optional<double> atol, std::sp
 // 2·10⁶ values at 10⁶ masses, 15-25 ms) wait until someone asks for them (summarize), after the run.
 void fillAtol(ToleranceVector& t, double base) {
   t.atol.resize(t.scale.size());
-  for (std::size_t i = 0; i < t.scale.size(); ++i) {
-    double value = base * t.scale[i];
-    // Guard against overflow or underflow of the product: IDA rejects a zero or infinite weight.
-    if (!std::isfinite(value) || value <= 0) value = base;
-    t.atol[i] = value;
-  }
+  inTwoHalves(t.scale.size(), [&](size_t first, size_t last) {
+    for (std::size_t i = first; i < last; ++i) {
+      double value = base * t.scale[i];
+      // Guard against overflow or underflow of the product: IDA rejects a zero or infinite weight.
+      if (!std::isfinite(value) || value <= 0) value = base;
+      t.atol[i] = value;
+    }
+  });
   ToleranceSummary& s = t.summary;
   s.solverRtol = t.solverRtol;
   s.atolUser = base;

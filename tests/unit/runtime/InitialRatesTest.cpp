@@ -33,6 +33,46 @@ TEST(DiagonalRates, AreFoundUpToTheOrderOfTheRows) {
   EXPECT_EQ(swapped->d, (std::vector<double>{4, 2}));
 }
 
+// A large matrix (from 65 536 columns) is searched in two halves on two threads: the same rates,
+// and a problem in either half still refuses it. Tridiagonal pattern, dF/dy' = diag(c + 1) placed
+// in row n − 1 − c (rows reversed, as a kinematic row after its dynamic one would put it).
+TEST(DiagonalRates, ALargeMatrixIsSearchedInTwoHalves) {
+  const int32_t n = 100001;
+  std::vector<int32_t> starts{0}, rows;
+  for (int32_t c = 0; c < n; ++c) {
+    for (int32_t r : {n - 2 - c, n - 1 - c, n - c})
+      if (r >= 0 && r < n) rows.push_back(r);
+    starts.push_back(static_cast<int32_t>(rows.size()));
+  }
+  std::vector<double> at0(rows.size()), at1;
+  for (size_t k = 0; k < at0.size(); ++k) at0[k] = std::sin(0.1 * static_cast<double>(k));
+  at1 = at0;
+  std::vector<size_t> diagonal(n);
+  for (int32_t c = 0; c < n; ++c)
+    for (int32_t k = starts[c]; k < starts[c + 1]; ++k)
+      if (rows[k] == n - 1 - c) diagonal[c] = static_cast<size_t>(k), at1[k] += c + 1;
+  auto rates = diagonalRates<int32_t>(starts, rows, at0, at1);
+  ASSERT_TRUE(rates);
+  for (int32_t c = 0; c < n; ++c) {
+    ASSERT_EQ(rates->rowOf[c], static_cast<uint32_t>(n - 1 - c)) << c;
+    ASSERT_EQ(rates->d[c], (at0[diagonal[c]] + (c + 1)) - at0[diagonal[c]]) << c;
+  }
+  for (int32_t c : {10, n - 10}) {  // a second entry in a column of the first, then of the second half
+    std::vector<double> coupled = at1;
+    coupled[diagonal[c] + 1] += 1;
+    EXPECT_FALSE(diagonalRates<int32_t>(starts, rows, at0, coupled)) << c;
+    std::vector<double> missing = at1;  // a column without its entry
+    missing[diagonal[c]] = at0[diagonal[c]];
+    EXPECT_FALSE(diagonalRates<int32_t>(starts, rows, at0, missing)) << c;
+  }
+  // Two columns with their entries in the same row (checked after the halves): each row is one column's.
+  std::vector<double> shared = at1;
+  shared[diagonal[n - 10]] = at0[diagonal[n - 10]];
+  size_t other = diagonal[n - 10] == static_cast<size_t>(starts[n - 10]) ? diagonal[n - 10] + 1 : diagonal[n - 10] - 1;
+  shared[other] += 1;  // column n − 10's entry now in row 8, column n − 9's
+  EXPECT_FALSE(diagonalRates<int32_t>(starts, rows, at0, shared));
+}
+
 TEST(DiagonalRates, AreRefusedForAnyOtherMatrix) {
   EXPECT_FALSE(ratesOf({0, 0, 0, 0}, {1, 1, 0, 1}));  // two entries in column 0 (a coupled mass matrix)
   EXPECT_FALSE(ratesOf({0, 0, 0, 0}, {1, 0, 1, 0}));  // two in row 0, none in row 1

@@ -117,6 +117,31 @@ TEST(ToleranceScales, RoundoffAfterCalcICDoesNotShrinkTheFloor) {
   EXPECT_EQ(toleranceScales(consistent, nominal, kind, start)[2], 25);
 }
 
+// From 65 536 unknowns the scales, floors and atol are computed in two halves on two threads: the
+// largest start value, alone in the second half, still sets every zero start's floor, and the
+// figures are those of the whole vector.
+TEST(ToleranceVector, ALargeModelsFloorsComeFromBothHalves) {
+  const size_t n = 100001;
+  std::vector<double> y0(n, 0.0), nominal(n, 0.0);
+  std::vector<int32_t> kind(n, 1);
+  y0[n - 3] = -1000;  // differential, in the second half
+  y0[7] = 2;
+  kind[5] = 0, y0[5] = 5;  // the only algebraic unknown (its floor its own, 5e-3)
+  nominal[9] = 0.25;
+  ToleranceVector v = buildTolerances(1e-6, std::nullopt, y0, nominal, kind);
+  double floor = kAutomaticScaleFloorFactor * 1000, c = calibratedRtol(1e-6);
+  EXPECT_EQ(v.scale[0], floor);
+  EXPECT_EQ(v.scale[n - 1], floor);
+  EXPECT_EQ(v.scale[n - 3], 1000);
+  EXPECT_EQ(v.scale[7], 2);
+  EXPECT_EQ(v.scale[5], 5);
+  EXPECT_EQ(v.scale[9], 0.25);
+  for (size_t i : {size_t{0}, size_t{5}, n / 2, n / 2 + 1, n - 3, n - 1}) EXPECT_EQ(v.atol[i], c * v.scale[i]) << i;
+  EXPECT_EQ(summarize(v).atolMax, c * 1000);
+  EXPECT_EQ(summarize(v).atolMin, c * 0.25);
+  EXPECT_EQ(summarize(v).atolMedian, c * floor);
+}
+
 TEST(ToleranceVector, MedianOfAnEvenCountIsTheMeanOfTheMiddleTwo) {
   std::vector<double> y0 = {1, 2, 4, 8};
   std::vector<int32_t> kind(4, 1);

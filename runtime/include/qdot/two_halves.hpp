@@ -1,7 +1,9 @@
 // inTwoHalves: a large loop whose iterations write only their own elements, split between this
 // thread and a second one (issue 15). The compiler is single-threaded and a large model's stages
 // spend their time writing one object per array element (symbols, variables) at 1-2 GB/s: the
-// second core, idle during the compile, makes half of them. Small loops stay on this thread.
+// second core, idle during the compile, makes half of them. The run time's passes over a large
+// model's pattern and vectors before IDA starts are split the same way. Small loops stay on this
+// thread.
 #pragma once
 
 #include <cstddef>
