@@ -312,12 +312,8 @@ struct FlatModel {
   const VariableAttributes& attributesOf(const Variable& v) const { return attributes[v.attributes]; }
   /// The relative element a symbol stands for, or nullptr.
   const RelativeElement* relativeElement(sym::Expr s) const { return patterns->find(s); }
-  std::vector<int> variablesWithRole(VarRole r) const {
-    std::vector<int> out;
-    for (int i = 0; i < static_cast<int>(variables.size()); ++i)
-      if (variables[i].role == r) out.push_back(i);
-    return out;
-  }
+  /// In order; a large model's variables (3·10⁶ at 10⁶ masses) are looked through in two halves.
+  std::vector<int> variablesWithRole(VarRole r) const;
 };
 
 }  // namespace qdot::flat

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "flatten/Flattener.h"
+#include "qdot/two_halves.hpp"
 #include "support/Assert.h"
 
 namespace qdot::flat {
@@ -172,6 +173,17 @@ void Flattener::countScalars(size_t n, SourceRange r) {
   if (scalars_ > limits_.maxScalars)
     fail(r, DiagCode::E0310, "the model expands to more than " + std::to_string(limits_.maxScalars) + " scalars",
          "reduce the array sizes or loop ranges");
+}
+
+std::vector<int> FlatModel::variablesWithRole(VarRole r) const {
+  std::vector<int> halves[2];
+  inTwoHalves(variables.size(), [&](size_t first, size_t last) {
+    std::vector<int>& out = halves[first == 0 ? 0 : 1];
+    for (size_t i = first; i < last; ++i)
+      if (variables[i].role == r) out.push_back(static_cast<int>(i));
+  });
+  halves[0].insert(halves[0].end(), halves[1].begin(), halves[1].end());
+  return std::move(halves[0]);
 }
 
 // The variable's name is its symbol's.

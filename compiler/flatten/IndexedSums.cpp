@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "flatten/Flattener.h"
+#include "qdot/two_halves.hpp"
 
 namespace qdot::flat {
 
@@ -842,8 +843,11 @@ Expr Flattener::rateOfRelative(const RelativeElement& rel) {
     if (constant) return ctx_.zero();
     if (!moving && !unknowns) throw NotATemplate{};
     if (made) {  // a coordinate array's velocities and accelerations exist already: read them
-      rates.reserve(a.elements.size());
-      for (Expr e : a.elements) rates.push_back(out_.variables[out_.variables[out_.variableOf(e)].derivative].symbol);
+      rates.resize(a.elements.size());
+      inTwoHalves(rates.size(), [&](size_t first, size_t last) {
+        for (size_t k = first; k < last; ++k)
+          rates[k] = out_.variables[out_.variables[out_.variableOf(a.elements[k])].derivative].symbol;
+      });
     } else {
       rates = derivativeSymbols(a.elements, derivativeSite_);
     }
