@@ -567,6 +567,51 @@ end Cubic;
   EXPECT_GE(loops, 1u);
 }
 
+// A chain of 70 001 masses — above the 65 536 elements from which the compile splits its passes
+// over a large array between two threads (qdot/two_halves.hpp: the symbols, which variables are
+// coordinates, the rates of the coordinate array, the model description, the start values and
+// nominals) — against its equations of motion written out by hand: the unknowns in order, the
+// start values, and at a state the residual m a_i + k (2 x_i − x_{i−1} − x_{i+1}) + c (2 v_i − v_{i−1}
+// − v_{i+1}) with the ends' terms (x_0 = 0 a wall, no spring after x_n), and the kinematic rows.
+TEST(LoopedKernels, ALargeChainsKernelsAreItsEquationsOfMotion) {
+  const size_t n = 70001;
+  Compiled c(R"(model Chain
+  parameter Integer n = 70001;
+  parameter Real m = 1.5, k = 1000, c = 0.5;
+  coordinate Real x[n](start = {0.01*i for i in 1:n});
+mechanics
+  kinetic = sum(0.5*m*der(x[i])^2 for i in 1:n);
+  potential = 0.5*k*x[1]^2 + sum(0.5*k*(x[i+1] - x[i])^2 for i in 1:n-1);
+  dissipation = 0.5*c*der(x[1])^2 + sum(0.5*c*(der(x[i+1]) - der(x[i]))^2 for i in 1:n-1);
+end Chain;
+)", true);
+  ASSERT_TRUE(c.ok);
+  const kernel::KernelModule& km = c.kernels();
+  ASSERT_EQ(km.variableCount(), 2 * n);
+  const auto& names = km.description->variableNames;
+  EXPECT_EQ(names[0], "x[1]");
+  EXPECT_EQ(names[n / 2], "x[" + std::to_string(n / 2 + 1) + "]");
+  EXPECT_EQ(names[n - 1], "x[70001]");
+  EXPECT_EQ(names[n], "der(x[1])");
+  EXPECT_EQ(names[2 * n - 1], "der(x[70001])");
+  EXPECT_GE(loopCount(km.program(ModelProgram::Residual)), 2u);
+  for (size_t j = 0; j < 2 * n; ++j) ASSERT_EQ(km.description->isDifferential[j], 1) << j;
+  test::KernelValues v = test::evaluateAt(km, 1);
+  for (size_t j = 0; j < n; ++j) ASSERT_EQ(v.start[j], 0.01 * static_cast<double>(j + 1)) << "x[" << j + 1 << "]";
+  for (size_t j = n; j < 6 * n; ++j) ASSERT_EQ(v.start[j], 0.0) << j;
+  // evaluateAt's state (trial 1): y_j = 0.1 sin(1.3 j + 1), y'_j = 0.2 cos(0.7 j + 2)
+  auto y = [](size_t j) { return 0.1 * std::sin(1.3 * static_cast<double>(j) + 1); };
+  auto yp = [](size_t j) { return 0.2 * std::cos(0.7 * static_cast<double>(j) + 2); };
+  const double m = 1.5, k = 1000, damping = 0.5;
+  for (size_t i = 0; i < n; ++i) {
+    double x = y(i), left = i > 0 ? y(i - 1) : 0.0, right = i + 1 < n ? y(i + 1) : x;
+    double u = y(n + i), uLeft = i > 0 ? y(n + i - 1) : 0.0, uRight = i + 1 < n ? y(n + i + 1) : u;
+    double expected = m * yp(n + i) + k * ((x - left) + (x - right)) + damping * ((u - uLeft) + (u - uRight));
+    ASSERT_NEAR(v.F[i], expected, 1e-12 * (1 + std::abs(expected))) << "row of x[" << i + 1 << "]";
+    ASSERT_NEAR(v.F[n + i], yp(i) - u, 1e-15) << "kinematic row of x[" << i + 1 << "]";
+  }
+}
+
 // A large array's start values are loops (kernel/KernelBuilder.cpp, numberRuns) that store the very
 // numbers flattening folded: 0.01*i for x[i], 0 for every velocity, derivative and nominal.
 TEST(LoopedKernels, StartValuesOfALargeArrayAreLoopsWithTheSameBits) {
