@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <string>
 #include <vector>
 
 #include "unit/pipeline/KernelPair.h"
@@ -488,9 +489,10 @@ end CoupledPendulums;
   test::expectScalarFallback(withAnEquation(text));
 }
 
-TEST(LoopedKernels, SpringChainGivesTheScalarResidualAndJacobian) {
-  size_t loops = expectSameKernels(R"(model Chain
-  parameter Integer n = 9;
+// The spring–damper chain of n masses (m = 1.5, k = 1000, c = 0.5), the first tied to a wall.
+std::string springChain(size_t n) {
+  return R"(model Chain
+  parameter Integer n = )" + std::to_string(n) + R"(;
   parameter Real m = 1.5, k = 1000, c = 0.5;
   coordinate Real x[n](start = {0.01*i for i in 1:n});
 mechanics
@@ -498,7 +500,11 @@ mechanics
   potential = 0.5*k*x[1]^2 + sum(0.5*k*(x[i+1] - x[i])^2 for i in 1:n-1);
   dissipation = 0.5*c*der(x[1])^2 + sum(0.5*c*(der(x[i+1]) - der(x[i]))^2 for i in 1:n-1);
 end Chain;
-)");
+)";
+}
+
+TEST(LoopedKernels, SpringChainGivesTheScalarResidualAndJacobian) {
+  size_t loops = expectSameKernels(springChain(9));
   EXPECT_EQ(loops, 2u);  // the interior's Euler–Lagrange rows and the kinematic rows
 }
 
@@ -575,16 +581,7 @@ end Cubic;
 // − v_{i+1}) with the ends' terms (x_0 = 0 a wall, no spring after x_n), and the kinematic rows.
 TEST(LoopedKernels, ALargeChainsKernelsAreItsEquationsOfMotion) {
   const size_t n = 70001;
-  Compiled c(R"(model Chain
-  parameter Integer n = 70001;
-  parameter Real m = 1.5, k = 1000, c = 0.5;
-  coordinate Real x[n](start = {0.01*i for i in 1:n});
-mechanics
-  kinetic = sum(0.5*m*der(x[i])^2 for i in 1:n);
-  potential = 0.5*k*x[1]^2 + sum(0.5*k*(x[i+1] - x[i])^2 for i in 1:n-1);
-  dissipation = 0.5*c*der(x[1])^2 + sum(0.5*c*(der(x[i+1]) - der(x[i]))^2 for i in 1:n-1);
-end Chain;
-)", true);
+  Compiled c(springChain(n), true);
   ASSERT_TRUE(c.ok);
   const kernel::KernelModule& km = c.kernels();
   ASSERT_EQ(km.variableCount(), 2 * n);

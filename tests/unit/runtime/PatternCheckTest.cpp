@@ -31,6 +31,17 @@ struct Pattern {
   }
 };
 
+// A model of as many differential unknowns as the pattern has columns.
+ModelDescription describing(const Pattern& p) {
+  ModelDescription d;
+  d.variableNames.assign(p.columns(), "x");
+  d.isDifferential.assign(p.columns(), 1);
+  d.fixed.assign(p.columns(), 0);
+  d.jacobianColumnStarts = p.starts;
+  d.jacobianRowIndices = p.rows;
+  return d;
+}
+
 TEST(PatternCheck, AWellFormedPatternPassesSmallAndLarge) {
   for (int32_t n : {1, 5, 70000, 200001}) {
     Pattern p(n);
@@ -77,24 +88,11 @@ TEST(PatternCheck, AStartPastTheNonzerosIsRefusedWithoutReadingPastThem) {
   Pattern p(100000);
   p.starts[50000] = static_cast<int32_t>(p.rows.size()) + 1000;
   EXPECT_FALSE(p.valid(p.columns()));
-
-  ModelDescription d;
-  d.variableNames.assign(p.columns(), "x");
-  d.isDifferential.assign(p.columns(), 1);
-  d.fixed.assign(p.columns(), 0);
-  d.jacobianColumnStarts = p.starts;
-  d.jacobianRowIndices = p.rows;
-  EXPECT_EQ(d.inconsistency(), "Jacobian column starts exceed the nonzeros");
+  EXPECT_EQ(describing(p).inconsistency(), "Jacobian column starts exceed the nonzeros");
 }
 
 TEST(PatternCheck, TheDescriptionNamesTheColumnOfABadRow) {
-  Pattern p(70000);
-  ModelDescription d;
-  d.variableNames.assign(p.columns(), "x");
-  d.isDifferential.assign(p.columns(), 1);
-  d.fixed.assign(p.columns(), 0);
-  d.jacobianColumnStarts = p.starts;
-  d.jacobianRowIndices = p.rows;
+  ModelDescription d = describing(Pattern(70000));
   EXPECT_EQ(d.inconsistency(), "");
   d.jacobianRowIndices[d.jacobianColumnStarts[60000] + 1] = 70000;
   EXPECT_EQ(d.inconsistency(), "Jacobian row indices out of range or not ascending in column 60000");
