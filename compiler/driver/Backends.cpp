@@ -140,15 +140,16 @@ void printTieringDecision(const RunnableModel& m, const rt::TierReport& tiers, s
         << " residual/Jacobian calls, projecting " << v.remainingVmSeconds * 1e3 << " ms more, of which native code saves ~"
         << v.savingSeconds * 1e3 << " ms ("
         << (seen.idleCores >= TieringRule{}.idleCore
-                ? fmt::format(">= the compile at an idle machine's speed, {:g} x the estimate: {:.2g} cores idle",
-                              TieringRule{}.idleCompileShare, seen.idleCores)
+                ? fmt::format(">= {:g} x the compile at an idle machine's speed, {:g} x the estimate: {:.2g} cores idle",
+                              v.payback, TieringRule{}.idleCompileShare, seen.idleCores)
                 : fmt::format(">= {:g} x the compile", v.payback))
         << ")\n";
   } else {
     log << "tiering: stayed on the VM: its " << seen.firstTierCalls << " residual/Jacobian calls took "
         << seen.firstTierSeconds * 1e3 << " ms of the run's " << seen.elapsedSeconds * 1e3
         << " ms; native code would never have saved "
-        << (seen.idleCores >= TieringRule{}.idleCore ? std::string("the compile at an idle machine's speed")
+        << (seen.idleCores >= TieringRule{}.idleCore ? fmt::format("{:g} x the compile at an idle machine's speed",
+                                                                   TieringRule{}.idlePayback)
                                                      : fmt::format("{:g} x the compile", TieringRule{}.payback))
         << "\n";
   }

@@ -64,15 +64,16 @@ TierVerdict decideTiering(const rt::TierObservation& seen, double compileSeconds
   v.remainingVmSeconds = seen.recentFirstTierSeconds * (1 - seen.progress) / seen.recentProgress;
   // A core the run has left idle takes the compile without taking the solver's time, at an idle
   // machine's speed (the estimate was measured under load): the compile is expected to take
-  // idleCompileShare of it, and the saving need only repay that once.
+  // idleCompileShare of it, and since a compile that comes too late costs the run nothing there,
+  // the saving need only be idlePayback of that, and the progress need not be past the first steps.
   bool idle = seen.idleCores >= rule.idleCore;
   double compile = idle ? rule.idleCompileShare * compileSeconds : compileSeconds;
-  v.payback = idle ? 1 : rule.payback;
+  v.payback = idle ? rule.idlePayback : rule.payback;
   // While it compiles the run stays on the VM, spending the share of its time it spent so far.
   double duringCompile = compile * std::min(1.0, seen.firstTierSeconds / seen.elapsedSeconds);
   double afterCompile = std::max(0.0, v.remainingVmSeconds - duringCompile);
   v.savingSeconds = afterCompile * (1 - 1 / rule.nativeSpeedup);
-  v.compile = seen.progress >= rule.minProgress && seen.firstTierSeconds >= rule.minObserved * compileSeconds &&
+  v.compile = (idle || seen.progress >= rule.minProgress) && seen.firstTierSeconds >= rule.minObserved * compileSeconds &&
               v.savingSeconds >= v.payback * compile;
   return v;
 }

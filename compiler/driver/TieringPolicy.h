@@ -50,9 +50,13 @@ struct TieringRule {
   /// Idle cores on average (TierObservation::idleCores) from which the compile is taken to cost
   /// the run nothing: it runs on a core the run leaves idle, at an idle machine's speed, taking
   /// `idleCompileShare` of the estimate (which was measured under load: car_axis 19 ms of CPU
-  /// against 40 ms estimated), and the saving need only repay that once, not `payback` times.
+  /// against 40 ms estimated on one machine, 14-16 ms on another). A compile that comes too late
+  /// to help then loses the run nothing (qdot run does not wait for it), so the saving need only
+  /// be `idlePayback` of that, and the run need not be past `minProgress` first: an early
+  /// extrapolation overstates what is left, which on an idle core costs nothing either.
   double idleCore = 0.75;
   double idleCompileShare = 0.5;
+  double idlePayback = 0.5;
 };
 
 struct TierVerdict {
@@ -61,7 +65,7 @@ struct TierVerdict {
   double savingSeconds = 0;       ///< what native code would save of it, after the compile
   /// Decided on one call's cost: native code saves more of a single call than the compile takes.
   bool oneCallPays = false;
-  double payback = 0;  ///< the payback asked for (rule.payback, or 1 with an idle core)
+  double payback = 0;  ///< the payback asked for (rule.payback, or rule.idlePayback with an idle core)
 };
 
 /// What one residual call of `k` is expected to take on the VM: its executed instructions

@@ -7,8 +7,9 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
 #include <thread>
+
+#include "sim/IdleCores.h"
 
 namespace qdot::rt {
 namespace {
@@ -35,34 +36,7 @@ double secondsBetween(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration<double>(to - from).count();
 }
 
-// The machine's CPU time so far, in clock ticks, from the first line of /proc/stat: all of it and
-// the idle part (idle + iowait). Both 0 where it cannot be read.
-struct CpuTicks {
-  uint64_t total = 0, idle = 0;
-};
-
-CpuTicks readCpuTicks() {
-  CpuTicks t;
-  std::FILE* f = std::fopen("/proc/stat", "r");
-  if (!f) return t;
-  unsigned long long v[8] = {};
-  if (std::fscanf(f, "cpu %llu %llu %llu %llu %llu %llu %llu %llu", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &v[6], &v[7]) == 8) {
-    for (unsigned long long x : v) t.total += x;
-    t.idle = v[3] + v[4];
-  }
-  std::fclose(f);
-  return t;
-}
-
-// Idle cores on average between two readings; -1 if unknown or the ticks are too few to tell
-// (a tick is 10 ms of one core).
-double idleCoresBetween(const CpuTicks& from, const CpuTicks& to) {
-  constexpr uint64_t kFewestTicks = 8;
-  if (from.total == 0 || to.total < from.total + kFewestTicks) return -1;
-  double cores = std::max(1u, std::thread::hardware_concurrency());
-  return cores * double(to.idle - from.idle) / double(to.total - from.total);
-}
-// How often the idle cores are read again (a read costs ~10 µs).
+// How often the idle cores are read again (a reading costs ~10-20 µs).
 constexpr double kIdleReadEvery = 5e-3;
 
 // What one reading of the clock costs, measured once: a timed call of the smallest models is
@@ -86,8 +60,7 @@ struct Tiered : QdotModel {
   std::thread compiler;
   double compileSeconds = 0;  // expected (0: unknown)
   Clock::time_point created = Clock::now(), compileStarted, idleRead = created;
-  CpuTicks createdTicks = readCpuTicks();
-  double idleCores = -1;
+  IdleCoreGauge idle;  // read when created, then at most every kIdleReadEvery
   std::atomic<bool> done{false};  // the compile thread has finished, or never started (release)
   std::atomic<double> readySeconds{0};
   // The solver thread's own: which tier answered last, what the first tier has cost, the horizon.
@@ -112,7 +85,7 @@ struct Tiered : QdotModel {
     o.firstTierCalls = firstCalls;
     o.recentProgress = o.progress - windowStart.progress;
     o.recentFirstTierSeconds = o.firstTierSeconds - windowStart.firstTierSeconds;
-    o.idleCores = idleCores;
+    o.idleCores = idle.idleCores();
     return o;
   }
 
@@ -120,7 +93,7 @@ struct Tiered : QdotModel {
     Clock::time_point now = Clock::now();
     if (secondsBetween(idleRead, now) < kIdleReadEvery) return;
     idleRead = now;
-    idleCores = idleCoresBetween(createdTicks, readCpuTicks());
+    idle.read();
   }
 
   void startCompile() {
@@ -270,6 +243,7 @@ ModelPtr createTieredModel(ModelPtr first, TierCompiler compile, TierTrigger tri
   t->compile = std::move(compile);
   t->trigger = std::move(trigger);
   t->done.store(true);  // nothing compiles until the trigger says so
+  if (t->trigger) t->idle.read();  // where the run's interval starts
   clockReadSeconds();   // measured now rather than inside the first timed call
   if (!t->trigger) t->startCompile();
   return ModelPtr(t);

@@ -97,20 +97,35 @@ TEST(TieringPolicy, TheRecentRateCountsNotTheRateSinceTheStart) {
 }
 
 // With a core left idle through the run so far, the compile takes nothing from the solver and runs
-// at an idle machine's speed (half the estimate): the saving need only repay that once. Unknown
-// (-1) or a busy machine keeps the estimate and the payback of 2.
-TEST(TieringPolicy, AnIdleCoreAsksTheSavingToRepayAnIdleMachinesCompileOnce) {
+// at an idle machine's speed (half the estimate); one that comes too late costs the run nothing,
+// so the saving need only be half of that, and the run need not be past its first 1 %. Unknown
+// (-1) or a busy machine keeps the estimate, the payback of 2 and the 1 %.
+TEST(TieringPolicy, AnIdleCoreAsksLessOfTheSaving) {
   rt::TierObservation seen = steadyRun(0.1, 0.2, 0.1);  // 0.9 s of VM calls to come, half of the run on the VM
   EXPECT_FALSE(decideTiering(seen, 0.4).compile);        // (0.9 - 0.4/2) x 3/4 = 0.525 < 2 x 0.4
   seen.idleCores = 0.9;
-  TierVerdict v = decideTiering(seen, 0.4);  // a 0.2 s compile: (0.9 - 0.1) x 3/4 = 0.6 >= 0.2
+  TierVerdict v = decideTiering(seen, 0.4);  // a 0.2 s compile: (0.9 - 0.1) x 3/4 = 0.6 >= 0.1
   EXPECT_TRUE(v.compile);
-  EXPECT_EQ(v.payback, 1.0);
+  EXPECT_EQ(v.payback, 0.5);
   EXPECT_NEAR(v.savingSeconds, 0.6, 1e-12);
-  EXPECT_FALSE(decideTiering(seen, 1.4).compile);  // 0.7 s: (0.9 - 0.35) x 3/4 = 0.4125 < 0.7
+  EXPECT_TRUE(decideTiering(seen, 1.0).compile);  // 0.5 s: (0.9 - 0.25) x 3/4 = 0.4875 >= 0.25
+  rt::TierObservation late = steadyRun(0.8, 0.2, 0.1);  // 25 ms to come: (0.025 - 0.05) < 0
+  late.idleCores = 0.9;
+  EXPECT_FALSE(decideTiering(late, 0.1).compile);
   seen.idleCores = 0.5;
   EXPECT_FALSE(decideTiering(seen, 0.4).compile);
   EXPECT_EQ(decideTiering(seen, 0.4).payback, 2.0);
+}
+
+TEST(TieringPolicy, AnIdleCoreNeedNotWaitForTheFirstPercent) {
+  // 0.5 % of the horizon, 20 ms of VM calls: the projection (about 4 s) is too early to trust,
+  // which on a busy machine waits, and on an idle core costs nothing if it is wrong.
+  rt::TierObservation early = steadyRun(0.005, 0.025, 0.02);
+  EXPECT_FALSE(decideTiering(early, 0.05).compile);
+  early.idleCores = 1;
+  EXPECT_TRUE(decideTiering(early, 0.05).compile);
+  // It still has to have seen a tenth of the estimate in VM calls.
+  EXPECT_FALSE(decideTiering(early, 0.5).compile);
 }
 
 TEST(TieringPolicy, TheEstimateFollowsTheCompilePlan) {
