@@ -73,7 +73,8 @@ TierVerdict decideTiering(const rt::TierObservation& seen, double compileSeconds
   double duringCompile = compile * std::min(1.0, seen.firstTierSeconds / seen.elapsedSeconds);
   double afterCompile = std::max(0.0, v.remainingVmSeconds - duringCompile);
   v.savingSeconds = afterCompile * (1 - 1 / rule.nativeSpeedup);
-  v.compile = (idle || seen.progress >= rule.minProgress) && seen.firstTierSeconds >= rule.minObserved * compileSeconds &&
+  double observed = idle ? rule.idleMinObserved : rule.minObserved;
+  v.compile = (idle || seen.progress >= rule.minProgress) && seen.firstTierSeconds >= observed * compileSeconds &&
               v.savingSeconds >= v.payback * compile;
   return v;
 }

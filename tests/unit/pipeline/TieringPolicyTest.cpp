@@ -124,8 +124,13 @@ TEST(TieringPolicy, AnIdleCoreNeedNotWaitForTheFirstPercent) {
   EXPECT_FALSE(decideTiering(early, 0.05).compile);
   early.idleCores = 1;
   EXPECT_TRUE(decideTiering(early, 0.05).compile);
-  // It still has to have seen a tenth of the estimate in VM calls.
-  EXPECT_FALSE(decideTiering(early, 0.5).compile);
+  // It still has to have seen 3 % of the estimate in VM calls (a tenth on a busy machine).
+  EXPECT_FALSE(decideTiering(early, 1.0).compile);  // 20 ms < 30 ms
+  rt::TierObservation fewCalls = steadyRun(0.05, 0.01, 0.006);
+  fewCalls.idleCores = 1;
+  EXPECT_TRUE(decideTiering(fewCalls, 0.1).compile);  // 6 ms >= 3 ms
+  fewCalls.idleCores = 0;
+  EXPECT_FALSE(decideTiering(fewCalls, 0.1).compile);  // 6 ms < 10 ms
 }
 
 TEST(TieringPolicy, TheEstimateFollowsTheCompilePlan) {
