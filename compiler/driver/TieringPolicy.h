@@ -52,12 +52,13 @@ struct TieringRule {
   /// `idleCompileShare` of the estimate (which was measured under load: car_axis 19 ms of CPU
   /// against 40 ms estimated on one machine, 14-16 ms on another). A compile that comes too late
   /// to help then loses the run nothing (qdot run does not wait for it), so the saving need only
-  /// be `idlePayback` of that, the VM calls need only have taken `idleMinObserved` of the
-  /// estimate, and the run need not be past `minProgress`: an early extrapolation overstates what
-  /// is left, which on an idle core costs nothing either.
+  /// be `idlePayback` of that (a tenth: anything worth having), the VM calls need only have taken
+  /// `idleMinObserved` of the estimate, and the run need not be past `minProgress`: an early
+  /// extrapolation overstates what is left, which on an idle core costs nothing either. (Compiling
+  /// at once whatever the run was measured: the small models 5-25 % slower than the VM alone.)
   double idleCore = 0.75;
   double idleCompileShare = 0.5;
-  double idlePayback = 0.5;
+  double idlePayback = 0.1;
   double idleMinObserved = 0.03;
 };
 

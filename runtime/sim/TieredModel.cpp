@@ -1,4 +1,4 @@
-// Every residual and Jacobian call goes to the second tier once it has been published (one acquire
+// Every residual, Jacobian, output and invariant call goes to the second tier once it has been published (one acquire
 // load per call), else to the first, timed (all or a sample); every other call goes to the first. The table (names,
 // sizes, Jacobian pattern) is the first tier's: both tiers are built from the same kernels.
 // lastError asks whichever tier made the last call. The ABI hands out const pointers to the model,
@@ -158,7 +158,7 @@ struct Tiered : QdotModel {
     return status;
   }
 
-  // A residual or Jacobian call: the second tier once published, else the first, timed.
+  // A residual, Jacobian, output or invariant call: the second tier once published, else the first, timed.
   template <class Call>
   int hot(Call call) {
     if (worthWaiting()) {
@@ -212,12 +212,10 @@ int jacobian(const QdotModel* s, double t, const double* y, const double* yp, co
   return self(s).hot([&](const QdotModel& m) { return m.jacobian(&m, t, y, yp, p, cj, values); });
 }
 int outputs(const QdotModel* s, double t, const double* y, const double* yp, const double* p, double* out) {
-  const QdotModel& m = self(s).cold();
-  return m.outputs(&m, t, y, yp, p, out);
+  return self(s).hot([&](const QdotModel& m) { return m.outputs(&m, t, y, yp, p, out); });
 }
 int invariants(const QdotModel* s, double t, const double* y, const double* yp, const double* p, double* out) {
-  const QdotModel& m = self(s).cold();
-  return m.invariants(&m, t, y, yp, p, out);
+  return self(s).hot([&](const QdotModel& m) { return m.invariants(&m, t, y, yp, p, out); });
 }
 const char* lastError(const QdotModel* s) {
   const QdotModel* m = self(s).last ? self(s).last : self(s).first.get();

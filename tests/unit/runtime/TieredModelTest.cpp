@@ -40,6 +40,10 @@ ModelPtr standIn(double value, std::atomic<int>* destroyed) {
     out[0] = static_cast<const StandIn*>(s)->value;
     return 0;
   };
+  m->parameters = [](const QdotModel* s, const double*, const uint8_t*, double* p) {
+    p[0] = static_cast<const StandIn*>(s)->value;
+    return 0;
+  };
   m->lastError = [](const QdotModel* s) { return static_cast<const StandIn*>(s)->error.c_str(); };
   m->destroy = [](QdotModel* s) {
     auto* self = static_cast<StandIn*>(s);
@@ -185,15 +189,30 @@ TEST(TieredModel, TheTriggerStartsTheCompileAndSeesTheProgress) {
   EXPECT_EQ(residualOf(m), 2.0);
 }
 
-TEST(TieredModel, OnlyTheResidualAndJacobianMoveToTheSecondTier) {
+// The calls a run repeats (residual and Jacobian per step, outputs per row) move to the second
+// tier and are counted as first-tier time before it; what runs once per run (parameters, start
+// values) stays on the first.
+TEST(TieredModel, TheCallsARunRepeatsMoveToTheSecondTier) {
   std::atomic<int> destroyed{0};
-  ModelPtr tiered = createTieredModel(standIn(1.0, &destroyed), [&](const std::atomic<bool>&) {
-    return standIn(2.0, &destroyed);
-  });
+  std::vector<TierObservation> seen;
+  ModelPtr tiered = createTieredModel(
+      standIn(1.0, &destroyed), [&](const std::atomic<bool>&) { return standIn(2.0, &destroyed); },
+      [&](const TierObservation& o) {
+        seen.push_back(o);
+        return o.firstTierCalls >= 16;
+      });
   QdotModel* m = tiered.get();
+  for (int k = 0; k < 8; ++k) EXPECT_EQ(outputOf(m), 1.0);
+  EXPECT_EQ(tierReport(m)->firstTierCalls, 8u);
+  ASSERT_EQ(seen.size(), 1u);  // asked after 8 calls, outputs among them
+  for (int k = 0; k < 8; ++k) EXPECT_EQ(residualOf(m), 1.0);
+  EXPECT_TRUE(tierReport(m)->started);
   waitForTheSecondTier(m);
-  EXPECT_EQ(residualOf(m), 2.0);
-  EXPECT_EQ(outputOf(m), 1.0);  // once per output row: not worth compiling
+  EXPECT_EQ(outputOf(m), 2.0);
+  EXPECT_STREQ(m->lastError(m), "tier 2");
+  double p = -1;
+  EXPECT_EQ(m->parameters(m, nullptr, nullptr, &p), 0);
+  EXPECT_EQ(p, 1.0);  // once per run: not worth moving
   EXPECT_STREQ(m->lastError(m), "tier 1");
 }
 
