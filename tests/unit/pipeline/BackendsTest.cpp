@@ -46,6 +46,53 @@ TEST(Backends, TieredModelOutlivesItsCompilation) {
   EXPECT_EQ(std::memcmp(onVm.data(), onJit.data(), onVm.size() * sizeof(double)), 0);
 }
 
+// What a model computes per output row (outputs, invariants) at a fixed state.
+std::vector<double> perRowAt(const QdotModel& m) {
+  std::vector<double> p(m.nParameters), y(m.nVariables, 0.3), yp(m.nVariables, -0.2);
+  std::vector<double> out(m.nOutputs + m.nInvariants);
+  EXPECT_EQ(m.parameters(&m, nullptr, nullptr, p.data()), 0);
+  EXPECT_EQ(m.outputs(&m, 0.5, y.data(), yp.data(), p.data(), out.data()), 0);
+  if (m.nInvariants > 0) {
+    EXPECT_EQ(m.invariants(&m, 0.5, y.data(), yp.data(), p.data(), out.data() + m.nOutputs), 0);
+  }
+  return out;
+}
+
+// The background JIT takes the outputs and invariants too (a rigid body's angles and rotation
+// matrices, written every output row; a pendulum's energy), and the tiered model sends them to it:
+// the same bits as the VM's.
+void expectPerRowCallsOnNativeCode(const std::string& file, bool outputs, bool invariants) {
+  const std::string text = test::readSource(file);
+  Compilation vm, tiered;
+  vm.options.keepInvariants = tiered.options.keepInvariants = invariants;  // --invariants
+  ASSERT_TRUE(compileSource(vm, file, text, "", Stage::Kernel));
+  ASSERT_TRUE(compileSource(tiered, file, text, "", Stage::Kernel));
+  RunnableModel onVm = makeRunnableModel(vm, Backend::Bytecode, invariants);
+  RunnableModel m = makeRunnableModel(tiered, Backend::Background, invariants);
+  ASSERT_TRUE(onVm.model && m.model) << onVm.error << m.error;
+  ASSERT_EQ(m.model->nOutputs > 0, outputs);
+  ASSERT_EQ(m.model->nInvariants > 0, invariants);
+  auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (rt::tierReport(m.model.get())->compiling && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  ASSERT_TRUE(rt::tierReport(m.model.get())->ready) << m.jit->error;
+  // Compiled, not interpreted.
+  if (outputs) {
+    EXPECT_NE(m.jit->stats.functions[programIndex(ModelProgram::Outputs)], 0u);
+  }
+  EXPECT_EQ(m.jit->stats.functions[programIndex(ModelProgram::Invariants)] != 0, invariants);
+  uint64_t before = rt::tierReport(m.model.get())->secondTierCalls;
+  std::vector<double> native = perRowAt(*m.model), interpreted = perRowAt(*onVm.model);
+  EXPECT_EQ(rt::tierReport(m.model.get())->secondTierCalls, before + 1 + (invariants ? 1 : 0));
+  ASSERT_EQ(native.size(), interpreted.size());
+  EXPECT_EQ(std::memcmp(native.data(), interpreted.data(), native.size() * sizeof(double)), 0);
+}
+
+TEST(Backends, OutputsAndInvariantsMoveToNativeCodeWithTheSameBits) {
+  expectPerRowCallsOnNativeCode("examples/rigid/fast_top.qd", true, false);
+  expectPerRowCallsOnNativeCode("examples/pendulum/double_pendulum.qd", false, true);
+}
+
 // qdot run's releaseStages: the flat model, the equations of motion, the DAE and the symbolic
 // nodes are gone once the kernels are built, the experiment is kept, the bytecode is moved into the
 // VM model — and every backend computes what it computes from a compilation that kept everything.
