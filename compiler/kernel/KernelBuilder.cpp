@@ -146,10 +146,15 @@ class Builder {
   }
 
   void addEquationSources() {
-    // Roughly one source per equation, per variable's start and nominal value, per parameter ...:
-    // reserved, as a large model has hundreds of thousands (each with two strings to move on growth).
-    m_.sources.reserve(dae_.equations.size() + 2 * dae_.variables.size() + dae_.parameters.size() +
-                       dae_.initialEquations.size() + dae_.outputs.size() + dae_.invariants.size());
+    // One source per scalar row, parameter, initial equation, output and invariant: reserved, as a
+    // large expanded model has hundreds of thousands (each with two strings to move on growth). A
+    // template block's rows share one; start values and nominals (one each where they are not
+    // numbers in runs) are left to grow: counting them here reserved 480 bytes per mass of the 10⁶
+    // chain that nothing wrote, and the heap prefaulter populated a lead of it.
+    size_t scalarRows = 0;
+    for (const auto& e : dae_.equations) scalarRows += e.residual != nullptr;
+    m_.sources.reserve(scalarRows + dae_.parameters.size() + dae_.initialEquations.size() + dae_.outputs.size() +
+                       dae_.invariants.size());
     // A template block's rows are served by its loop's one source (blockSource), not one each.
     for (size_t i = 0; i < dae_.equations.size(); ++i) {
       const auto& e = dae_.equations[i];

@@ -1,6 +1,7 @@
-// Every residual, Jacobian, output and invariant call goes to the second tier once it has been published (one acquire
-// load per call), else to the first, timed (all or a sample); every other call goes to the first. The table (names,
-// sizes, Jacobian pattern) is the first tier's: both tiers are built from the same kernels.
+// Every residual, Jacobian, output and invariant call goes to the second tier once it has been
+// published (one acquire load per call), else to the first, timed (all or a sample); every other
+// call goes to the first. The table (names, sizes, Jacobian pattern) is the first tier's: both
+// tiers are built from the same kernels.
 // lastError asks whichever tier made the last call. The ABI hands out const pointers to the model,
 // but the tiered model is ours and mutable: its counters and the trigger live on the solver thread.
 #include "sim/TieredModel.h"
@@ -158,7 +159,8 @@ struct Tiered : QdotModel {
     return status;
   }
 
-  // A residual, Jacobian, output or invariant call: the second tier once published, else the first, timed.
+  // A residual, Jacobian, output or invariant call: the second tier once published, else the
+  // first, timed.
   template <class Call>
   int hot(Call call) {
     if (worthWaiting()) {
