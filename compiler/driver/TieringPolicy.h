@@ -50,14 +50,16 @@ struct TieringRule {
   /// Idle cores on average (TierObservation::idleCores) from which the compile is taken to cost
   /// the run nothing: it runs on a core the run leaves idle, at an idle machine's speed, taking
   /// `idleCompileShare` of the estimate (which was measured under load: car_axis 19 ms of CPU
-  /// against 40 ms estimated on one machine, 14-16 ms on another). A compile that comes too late
+  /// against 40 ms estimated on one machine, 14-16 ms on another; eight models there 0.31-0.57 of
+  /// their estimates, typically 0.4; taken too low it only starts a compile that, on the idle
+  /// core, comes later than foreseen). A compile that comes too late
   /// to help then loses the run nothing (qdot run does not wait for it), so the saving need only
   /// be `idlePayback` of that (a tenth: anything worth having), the VM calls need only have taken
   /// `idleMinObserved` of the estimate, and the run need not be past `minProgress`: an early
   /// extrapolation overstates what is left, which on an idle core costs nothing either. (Compiling
   /// at once whatever the run was measured: the small models 5-25 % slower than the VM alone.)
   double idleCore = 0.75;
-  double idleCompileShare = 0.5;
+  double idleCompileShare = 0.4;
   double idlePayback = 0.1;
   double idleMinObserved = 0.03;
 };

@@ -54,7 +54,7 @@ void IdleCoreGauge::add(const MachineReading& r) {
 }
 
 double IdleCoreGauge::idleCores() const {
-  if (hasTicks_ && last_.total >= first_.total + kFewestTicks)
+  if (fromTicks())
     return double(cores_) * double(last_.idle - first_.idle) / double(last_.total - first_.total);
   if (instants_ < 2) return -1;
   // The lower median: a kernel thread runnable for a moment (rcu, a kworker) at one instant does

@@ -42,6 +42,8 @@ class IdleCoreGauge {
   /// Idle cores on average since the first reading: from the ticks once they cover
   /// kFewestTicks, else the (lower) median of the instants from two readings on, else -1 (unknown).
   double idleCores() const;
+  /// Whether idleCores() answers from the tick counters (else from the instants, or not at all).
+  bool fromTicks() const { return hasTicks_ && last_.total >= first_.total + kFewestTicks; }
 
   /// Ticks (summed over cores) from which the tick counters answer: 80 ms of one core.
   static constexpr uint64_t kFewestTicks = 8;

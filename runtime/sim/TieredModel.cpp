@@ -37,8 +37,11 @@ double secondsBetween(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration<double>(to - from).count();
 }
 
-// How often the idle cores are read again (a reading costs ~10-20 µs).
+// How often the idle cores are read again (a reading costs ~10-20 µs, and only until the compile
+// starts): every 2 ms while the gauge answers from instants, so that one taken while the previous
+// process was still exiting is outvoted by the first decision (5 ms into a run), then every 5 ms.
 constexpr double kIdleReadEvery = 5e-3;
+constexpr double kIdleReadEarly = 2e-3;
 
 // What one reading of the clock costs, measured once: a timed call of the smallest models is
 // mostly clock, and counting it as model time would overstate what native code can save.
@@ -61,7 +64,7 @@ struct Tiered : QdotModel {
   std::thread compiler;
   double compileSeconds = 0;  // expected (0: unknown)
   Clock::time_point created = Clock::now(), compileStarted, idleRead = created;
-  IdleCoreGauge idle;  // read when created, then at most every kIdleReadEvery
+  IdleCoreGauge idle;  // read when created, then at most every kIdleReadEarly / kIdleReadEvery
   std::atomic<bool> done{false};  // the compile thread has finished, or never started (release)
   std::atomic<double> readySeconds{0};
   // The solver thread's own: which tier answered last, what the first tier has cost, the horizon.
@@ -92,7 +95,7 @@ struct Tiered : QdotModel {
 
   void refreshIdleCores() {
     Clock::time_point now = Clock::now();
-    if (secondsBetween(idleRead, now) < kIdleReadEvery) return;
+    if (secondsBetween(idleRead, now) < (idle.fromTicks() ? kIdleReadEvery : kIdleReadEarly)) return;
     idleRead = now;
     idle.read();
   }

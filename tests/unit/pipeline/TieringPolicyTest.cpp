@@ -97,23 +97,23 @@ TEST(TieringPolicy, TheRecentRateCountsNotTheRateSinceTheStart) {
 }
 
 // With a core left idle through the run so far, the compile takes nothing from the solver and runs
-// at an idle machine's speed (half the estimate); one that comes too late costs the run nothing,
+// at an idle machine's speed (0.4 of the estimate); one that comes too late costs the run nothing,
 // so the saving need only be a tenth of that, and the run need not be past its first 1 %. Unknown
 // (-1) or a busy machine keeps the estimate, the payback of 2 and the 1 %.
 TEST(TieringPolicy, AnIdleCoreAsksLittleOfTheSaving) {
   rt::TierObservation seen = steadyRun(0.1, 0.2, 0.1);  // 0.9 s of VM calls to come, half of the run on the VM
   EXPECT_FALSE(decideTiering(seen, 0.4).compile);        // (0.9 - 0.4/2) x 3/4 = 0.525 < 2 x 0.4
   seen.idleCores = 0.9;
-  TierVerdict v = decideTiering(seen, 0.4);  // a 0.2 s compile: (0.9 - 0.1) x 3/4 = 0.6 >= 0.02
+  TierVerdict v = decideTiering(seen, 0.4);  // a 0.16 s compile: (0.9 - 0.08) x 3/4 = 0.615 >= 0.016
   EXPECT_TRUE(v.compile);
   EXPECT_EQ(v.payback, 0.1);
-  EXPECT_NEAR(v.savingSeconds, 0.6, 1e-12);
-  // Half the horizon, 0.1 s of VM calls to come: a 0.15 s compile (estimate 0.3 s) saves
-  // (0.1 - 0.075) x 3/4 = 18.75 ms >= 15 ms; a 0.18 s one 7.5 ms < 18 ms.
+  EXPECT_NEAR(v.savingSeconds, 0.615, 1e-12);
+  // Half the horizon, 0.1 s of VM calls to come: a 0.15 s compile (estimate 0.375 s) saves
+  // (0.1 - 0.075) x 3/4 = 18.75 ms >= 15 ms; a 0.18 s one (estimate 0.45 s) 7.5 ms < 18 ms.
   rt::TierObservation halfway = steadyRun(0.5, 0.2, 0.1);
   halfway.idleCores = 0.9;
-  EXPECT_TRUE(decideTiering(halfway, 0.3).compile);
-  EXPECT_FALSE(decideTiering(halfway, 0.36).compile);
+  EXPECT_TRUE(decideTiering(halfway, 0.375).compile);
+  EXPECT_FALSE(decideTiering(halfway, 0.45).compile);
   seen.idleCores = 0.5;
   EXPECT_FALSE(decideTiering(seen, 0.4).compile);
   EXPECT_EQ(decideTiering(seen, 0.4).payback, 2.0);
