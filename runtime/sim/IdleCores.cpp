@@ -41,7 +41,6 @@ IdleCoreGauge::IdleCoreGauge(unsigned cores)
       idleAtInstants_(static_cast<size_t>(cores_) + 1, 0) {}
 
 void IdleCoreGauge::add(const MachineReading& r) {
-  if (std::getenv("QDOT_DEBUG_IDLE") && r.runnable >= 2) { std::system("for t in /proc/[0-9]*/task/*/stat; do awk '$3==\"R\"{print FILENAME, $2, $3}' $t 2>/dev/null; done >&2"); }
   if (r.ticks.total > 0) {
     if (!hasTicks_) first_ = r.ticks;
     last_ = r.ticks;
